@@ -1,0 +1,33 @@
+//! Benchmarks: parse + lower, and the 200-step pendulum (P2) run.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use mbd::model::Overrides;
+
+fn pendulum_text() -> String {
+    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/models/pendulum.mbd"))
+        .unwrap_or_default()
+}
+
+fn compile(c: &mut Criterion) {
+    let text = pendulum_text();
+    c.bench_function("pendulum: parse + check + lower", |b| {
+        b.iter(|| mbd::compile("pendulum.mbd", &text, &[], Overrides::default()).is_ok())
+    });
+}
+
+fn run(c: &mut Criterion) {
+    let text = pendulum_text();
+    let Ok(compiled) = mbd::compile("pendulum.mbd", &text, &[], Overrides::default()) else {
+        return;
+    };
+    let mut out = Vec::with_capacity(1 << 16);
+    c.bench_function("pendulum: 200 HHT steps (run + CSV)", |b| {
+        b.iter(|| {
+            out.clear();
+            mbd::run(&compiled, &mut out).is_ok()
+        })
+    });
+}
+
+criterion_group!(benches, compile, run);
+criterion_main!(benches);

@@ -1,0 +1,253 @@
+//! mbd: a compiler and runtime for the `.mbd` flexible multibody modelling language.
+//!
+//! The pipeline, one stage per module, data flowing one way:
+//! text -> [`syntax`] (AST with spans) -> [`model`] (names, units, topology, unknown order)
+//! -> [`lower`] (runtime System + provenance) -> [`solve`] over [`runtime`] -> [`output`].
+//! This file is the library API: [`compile`] and [`run`]. It does no file IO of its own except
+//! writing to the writer it is given.
+
+// Numerical kernels index several arrays by one loop variable; iterators would obscure them.
+#![allow(clippy::needless_range_loop)]
+// Diagnostics are returned by value on cold paths only.
+#![allow(clippy::result_large_err)]
+
+pub mod diagnostics;
+pub mod lower;
+pub mod model;
+pub mod output;
+pub mod runtime;
+pub mod solve;
+pub mod source;
+pub mod syntax;
+
+use diagnostics::{Code, Diagnostic, Sink};
+use lower::Provenance;
+use model::{Model, Overrides};
+use runtime::System;
+use solve::{FailureKind, Method, NoticeKind, RunStats, RuntimeFailure, Settings, StartMode};
+use source::SourceMap;
+use std::io::Write;
+
+/// A compiled model: every stage's product, kept for `mbd check --emit`.
+pub struct Compiled {
+    pub sources: SourceMap,
+    pub ast: syntax::ast::File,
+    pub model: Model,
+    pub system: System,
+    pub provenance: Provenance,
+    /// Warnings found while compiling.
+    pub warnings: Vec<Diagnostic>,
+}
+
+/// Compilation failed: the diagnostics (errors and warnings) and the texts they point into.
+pub struct CompileFailure {
+    pub sources: SourceMap,
+    pub diagnostics: Vec<Diagnostic>,
+}
+
+/// Compiles model text. `sets` are the raw `NAME=VALUE` texts of `--set` flags.
+pub fn compile(
+    name: &str,
+    text: &str,
+    sets: &[String],
+    mut overrides: Overrides,
+) -> Result<Compiled, CompileFailure> {
+    let mut sources = SourceMap::new();
+    let id = sources.add(name, text);
+    let mut sink = Sink::default();
+    for s in sets {
+        let sid = sources.add("--set", s.clone());
+        match syntax::parse_set_arg(s, sid) {
+            Ok(pair) => overrides.sets.push(pair),
+            Err(d) => sink.push(
+                d.hint("write `--set NAME=VALUE`, e.g. `--set V0=5` (SI units) or `--set V0=5m/s`"),
+            ),
+        }
+    }
+    let ast = match syntax::parse_file(text, id) {
+        Ok(ast) => ast,
+        Err(d) => {
+            sink.push(d);
+            return Err(CompileFailure {
+                sources,
+                diagnostics: sink.diagnostics,
+            });
+        }
+    };
+    let model = match model::build(&ast, &overrides, &mut sink) {
+        Some(m) if !sink.has_errors() => m,
+        _ => {
+            return Err(CompileFailure {
+                sources,
+                diagnostics: sink.diagnostics,
+            })
+        }
+    };
+    let (system, provenance) = lower::lower(&model);
+    Ok(Compiled {
+        sources,
+        ast,
+        model,
+        system,
+        provenance,
+        warnings: sink.diagnostics,
+    })
+}
+
+impl Compiled {
+    /// Solver settings from the model's `solve` block (with command-line overrides applied).
+    pub fn settings(&self) -> Settings {
+        let s = &self.model.solve;
+        Settings {
+            method: match s.integrator {
+                model::Integrator::Hht => Method::Hht,
+                model::Integrator::Fet => Method::Fet,
+            },
+            alpha: s.alpha,
+            dt: s.dt,
+            steps: s.steps,
+            every: s.every,
+            start: match s.start {
+                model::Start::Consistent => StartMode::Consistent,
+                model::Start::ZeroAcceleration => StartMode::ZeroAcceleration,
+            },
+            increment_tolerance: s.tolerance,
+            residual_tolerance: 1e-8,
+            max_iterations: s.max_iterations,
+            max_halvings: 3,
+        }
+    }
+
+    /// A runtime failure as a diagnostic pointing at the entity's declaration.
+    pub fn failure_diagnostic(&self, f: &RuntimeFailure) -> Diagnostic {
+        let (code, what, hint) = match f.kind {
+            FailureKind::NewtonDiverged => (Code::E0601, "Newton iteration failed", "try a smaller time step (--dt), more numerical dissipation (--alpha -0.3), or check for a load or motion that is discontinuous or too large"),
+            FailureKind::Singular => (Code::E0602, "singular iteration matrix", "check that every body has a positive mass and that no two joints constrain the same motion"),
+            FailureKind::NonFinite => (Code::E0603, "non-finite values", "try a smaller time step (--dt); check params for extreme values"),
+            FailureKind::Unsupported => (Code::E0604, "integrator not available", "use `--integrator hht`"),
+        };
+        let entity = f
+            .entity
+            .and_then(|e| self.system.entities.get(e).map(|x| (e, x)));
+        let place = match entity {
+            Some((_, x)) => format!("; largest residual in {} `{}`", x.kind, x.name),
+            None => String::new(),
+        };
+        let mut d = Diagnostic::error(
+            code,
+            format!(
+                "{what} at t = {} s (step {}){place}: {}",
+                f.t, f.step, f.detail
+            ),
+        )
+        .hint(hint);
+        if let Some((e, x)) = entity {
+            if let Some(span) = self.provenance.spans.get(e) {
+                d = d.at(*span, format!("{} `{}` declared here", x.kind, x.name));
+            }
+        } else {
+            d = d.at(self.model.solve.span, "while solving this");
+        }
+        d
+    }
+}
+
+/// What a finished run reports.
+pub struct RunReport {
+    pub stats: RunStats,
+    pub warnings: Vec<Diagnostic>,
+    pub rows: usize,
+}
+
+/// A failed run: the failure as a diagnostic, plus what was done before it.
+pub struct RunFailure {
+    pub diagnostic: Diagnostic,
+    pub failure: Option<RuntimeFailure>,
+    pub warnings: Vec<Diagnostic>,
+    pub rows: usize,
+}
+
+/// Simulates a compiled model, writing CSV rows to `out` as they are computed.
+pub fn run(c: &Compiled, out: &mut dyn Write) -> Result<RunReport, RunFailure> {
+    let set = c.settings();
+    let sys = &c.system;
+    let io_fail = |e: std::io::Error, rows| RunFailure {
+        diagnostic: Diagnostic::error(Code::E0603, format!("cannot write the output: {e}"))
+            .hint("check the output path and free disk space"),
+        failure: None,
+        warnings: Vec::new(),
+        rows,
+    };
+    if set.method == Method::Fet {
+        let f = RuntimeFailure {
+            kind: FailureKind::Unsupported,
+            t: 0.0,
+            step: 0,
+            entity: None,
+            detail: "time finite elements (fet) are not available in this version".to_string(),
+        };
+        return Err(RunFailure {
+            diagnostic: c
+                .failure_diagnostic(&f)
+                .at(c.model.solve.span, "requested here"),
+            failure: Some(f),
+            warnings: Vec::new(),
+            rows: 0,
+        });
+    }
+    let mut csv = output::CsvWriter::new(out, sys).map_err(|e| io_fail(e, 0))?;
+    let mut warnings = Vec::new();
+    let fail = |f: RuntimeFailure,
+                csv: &mut output::CsvWriter<&mut dyn Write>,
+                warnings: Vec<Diagnostic>,
+                rows| {
+        let _ = csv.flush();
+        RunFailure {
+            diagnostic: c.failure_diagnostic(&f),
+            failure: Some(f),
+            warnings,
+            rows,
+        }
+    };
+    let mut hht = match solve::Hht::new(sys, &set) {
+        Ok(h) => h,
+        Err(f) => return Err(fail(f, &mut csv, warnings, 0)),
+    };
+    match hht.initialize() {
+        Ok(notices) => {
+            for n in notices {
+                let code = match n.kind {
+                    NoticeKind::VelocityProjected => Code::W0601,
+                    NoticeKind::PositionProjected => Code::W0602,
+                };
+                let mut d = Diagnostic::error(code, n.detail).hint(code.doc().to_string());
+                if let Some(span) = n.entity.and_then(|e| c.provenance.spans.get(e)) {
+                    d = d.at(*span, "this joint");
+                }
+                warnings.push(d);
+            }
+        }
+        Err(f) => return Err(fail(f, &mut csv, warnings, 0)),
+    }
+    csv.row(sys, hht.state(), hht.augment())
+        .map_err(|e| io_fail(e, 0))?;
+    let mut rows = 1;
+    for k in 1..=set.steps {
+        if let Err(f) = hht.step(k, set.dt) {
+            return Err(fail(f, &mut csv, warnings, rows));
+        }
+        // Exact step times, free of accumulated round-off.
+        hht.set_time(k as f64 * set.dt);
+        if k % set.every == 0 || k == set.steps {
+            csv.row(sys, hht.state(), hht.augment())
+                .map_err(|e| io_fail(e, rows))?;
+            rows += 1;
+        }
+    }
+    csv.flush().map_err(|e| io_fail(e, rows))?;
+    Ok(RunReport {
+        stats: hht.stats().clone(),
+        warnings,
+        rows,
+    })
+}

@@ -1,0 +1,340 @@
+//! The `mbd` command line: the only place that reads files and renders reports.
+//! Exit codes: 0 success; 1 the model has errors; 2 bad command-line usage; 3 the simulation
+//! failed at run time (the CSV keeps every row computed before the failure).
+
+use clap::{Parser, Subcommand, ValueEnum};
+use mbd::diagnostics::{explain, render_human, render_json, Diagnostic};
+use mbd::model::{Integrator, Overrides, Start};
+use mbd::source::SourceMap;
+use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
+
+#[derive(Parser)]
+#[command(
+    name = "mbd",
+    version,
+    about = "Compile and simulate .mbd flexible multibody models"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Simulate a model and write its output channels as CSV.
+    Run {
+        /// The model file.
+        model: String,
+        /// Write the CSV here (default: standard output).
+        #[arg(short = 'o', long = "output")]
+        output: Option<String>,
+        /// Override a param: NAME=VALUE, VALUE in SI units or with units (V0=5, V0=5m/s).
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        /// Time integrator.
+        #[arg(long, value_enum)]
+        integrator: Option<IntegratorArg>,
+        /// HHT alpha, in [-1/3, 0].
+        #[arg(long, allow_negative_numbers = true)]
+        alpha: Option<f64>,
+        /// Time step in seconds.
+        #[arg(long, conflicts_with = "steps")]
+        dt: Option<f64>,
+        /// Number of steps (the time step becomes until/N).
+        #[arg(long)]
+        steps: Option<usize>,
+        /// End time in seconds.
+        #[arg(long)]
+        until: Option<f64>,
+        /// Write every K-th step.
+        #[arg(long)]
+        every: Option<usize>,
+        /// Initial accelerations: consistent (default) or zero (the paper's start).
+        #[arg(long, value_enum)]
+        start: Option<StartArg>,
+        /// Diagnostics format.
+        #[arg(long, value_enum, default_value = "human")]
+        format: Format,
+    },
+    /// Check a model and print a summary, or one stage of the compilation.
+    Check {
+        model: String,
+        #[arg(long, value_enum, default_value = "human")]
+        format: Format,
+        /// Print a stage instead of the summary.
+        #[arg(long, value_enum)]
+        emit: Option<Emit>,
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+    },
+    /// Explain a diagnostic code, e.g. `mbd explain E0202`.
+    Explain { code: String },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum IntegratorArg {
+    Hht,
+    Fet,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum StartArg {
+    Consistent,
+    Zero,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum Format {
+    Human,
+    Json,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Emit {
+    Ast,
+    Model,
+    Dofs,
+    Ir,
+}
+
+const EXIT_MODEL: u8 = 1;
+const EXIT_USAGE: u8 = 2;
+const EXIT_RUNTIME: u8 = 3;
+
+fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) => {
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { EXIT_USAGE } else { 0 });
+        }
+    };
+    match cli.command {
+        Command::Explain { code } => match explain(&code) {
+            Some(text) => {
+                print!("{text}");
+                ExitCode::SUCCESS
+            }
+            None => {
+                eprintln!("error: unknown diagnostic code `{code}`");
+                ExitCode::from(EXIT_USAGE)
+            }
+        },
+        Command::Check {
+            model,
+            format,
+            emit,
+            set,
+        } => check(&model, format, emit, &set),
+        Command::Run {
+            model,
+            output,
+            set,
+            integrator,
+            alpha,
+            dt,
+            steps,
+            until,
+            every,
+            start,
+            format,
+        } => {
+            if let Some(a) = alpha {
+                if !(-1.0 / 3.0 - 1e-12..=0.0).contains(&a) {
+                    return usage(&format!("--alpha {a} is outside [-1/3, 0]"));
+                }
+            }
+            for (flag, v) in [("--dt", dt), ("--until", until)] {
+                if let Some(v) = v {
+                    if !(v > 0.0 && v.is_finite()) {
+                        return usage(&format!(
+                            "{flag} must be a positive number of seconds, got {v}"
+                        ));
+                    }
+                }
+            }
+            if steps == Some(0) || every == Some(0) {
+                return usage("--steps and --every must be at least 1");
+            }
+            let overrides = Overrides {
+                sets: Vec::new(),
+                integrator: integrator.map(|i| match i {
+                    IntegratorArg::Hht => Integrator::Hht,
+                    IntegratorArg::Fet => Integrator::Fet,
+                }),
+                alpha,
+                dt,
+                steps,
+                until,
+                every,
+                start: start.map(|s| match s {
+                    StartArg::Consistent => Start::Consistent,
+                    StartArg::Zero => Start::ZeroAcceleration,
+                }),
+            };
+            run(&model, output.as_deref(), &set, overrides, format)
+        }
+    }
+}
+
+fn usage(msg: &str) -> ExitCode {
+    eprintln!("error: {msg}");
+    ExitCode::from(EXIT_USAGE)
+}
+
+fn read(path: &str) -> Result<String, ExitCode> {
+    std::fs::read_to_string(path)
+        .map_err(|e| usage(&format!("cannot read model file `{path}`: {e}")))
+}
+
+fn report(diags: &[Diagnostic], sources: &SourceMap, format: Format) {
+    if diags.is_empty() {
+        return;
+    }
+    let mut err = std::io::stderr().lock();
+    match format {
+        Format::Json => {
+            let _ = writeln!(err, "{}", render_json(diags, sources));
+        }
+        Format::Human => {
+            let color = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
+            for d in diags {
+                let _ = write!(err, "{}", render_human(d, sources, color));
+            }
+        }
+    }
+}
+
+fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> ExitCode {
+    let text = match read(path) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    let c = match mbd::compile(path, &text, sets, Overrides::default()) {
+        Ok(c) => c,
+        Err(f) => {
+            report(&f.diagnostics, &f.sources, format);
+            return ExitCode::from(EXIT_MODEL);
+        }
+    };
+    report(&c.warnings, &c.sources, format);
+    let json = |v: Result<String, serde_json::Error>| {
+        v.unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    };
+    let out = match emit {
+        Some(Emit::Ast) => json(serde_json::to_string_pretty(&c.ast)),
+        Some(Emit::Model) => json(serde_json::to_string_pretty(&c.model)),
+        Some(Emit::Dofs) => json(serde_json::to_string_pretty(&c.model.dofs)),
+        Some(Emit::Ir) => json(serde_json::to_string_pretty(&c.system)),
+        None => summary(&c, format),
+    };
+    println!("{out}");
+    ExitCode::SUCCESS
+}
+
+fn summary(c: &mbd::Compiled, format: Format) -> String {
+    let m = &c.model;
+    let n = m.dofs.len();
+    let mult = m.dofs.multipliers();
+    let pattern = mbd::runtime::Pattern::of(n, &c.system.elements);
+    if format == Format::Json {
+        return serde_json::json!({
+            "model": m.name, "bodies": m.bodies.len(), "nodes": m.bodies.len(), "joints": m.joints.len(),
+            "dofs": n - mult, "multipliers": mult, "unknowns": n, "bandwidth": m.dofs.bandwidth,
+            "nonzeros": pattern.nnz(), "channels": c.system.channels.iter().map(|ch| ch.column.clone()).collect::<Vec<_>>(),
+            "steps": m.solve.steps, "dt": m.solve.dt, "until": m.solve.until,
+        })
+        .to_string();
+    }
+    let order: Vec<String> = m
+        .dofs
+        .unknowns
+        .iter()
+        .map(|u| match *u {
+            mbd::model::dofs::Unknown::Translation { body, axis } => {
+                format!("{}.u{}", m.bodies[body].name, ["x", "y", "z"][axis])
+            }
+            mbd::model::dofs::Unknown::Multiplier { joint, row } => {
+                format!("{}.lambda{}", m.joints[joint].name, row)
+            }
+        })
+        .collect();
+    format!(
+        "model {}: ok\n  bodies       {} ({} nodes)\n  joints       {}\n  DOFs         {}\n  multipliers  {}\n  unknowns     {} (order: {})\n  bandwidth    {}\n  nonzeros     {}\n  outputs      t, {}\n  solve        {} steps of {} s to {} s",
+        m.name,
+        m.bodies.len(),
+        m.bodies.len(),
+        m.joints.len(),
+        n - mult,
+        mult,
+        n,
+        order.join(" "),
+        m.dofs.bandwidth,
+        pattern.nnz(),
+        c.system.channels.iter().map(|ch| ch.column.as_str()).collect::<Vec<_>>().join(", "),
+        m.solve.steps,
+        m.solve.dt,
+        m.solve.until
+    )
+}
+
+fn run(
+    path: &str,
+    output: Option<&str>,
+    sets: &[String],
+    overrides: Overrides,
+    format: Format,
+) -> ExitCode {
+    let text = match read(path) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    let c = match mbd::compile(path, &text, sets, overrides) {
+        Ok(c) => c,
+        Err(f) => {
+            report(&f.diagnostics, &f.sources, format);
+            return ExitCode::from(EXIT_MODEL);
+        }
+    };
+    report(&c.warnings, &c.sources, format);
+    let mut sink: Box<dyn Write> = match output {
+        Some(p) => match std::fs::File::create(p) {
+            Ok(f) => Box::new(f),
+            Err(e) => return usage(&format!("cannot create output file `{p}`: {e}")),
+        },
+        None => Box::new(std::io::stdout().lock()),
+    };
+    let started = std::time::Instant::now();
+    match mbd::run(&c, &mut sink) {
+        Ok(r) => {
+            report(&r.warnings, &c.sources, format);
+            if format == Format::Human {
+                eprintln!(
+                    "{}: {} steps, {} Newton iterations, {} halvings, max |C| {:.2e} m, {} rows{} in {:.3} s",
+                    c.model.name,
+                    r.stats.steps,
+                    r.stats.newton_iterations,
+                    r.stats.halvings,
+                    r.stats.max_constraint_violation,
+                    r.rows,
+                    output.map(|p| format!(" to {p}")).unwrap_or_default(),
+                    started.elapsed().as_secs_f64()
+                );
+            }
+            ExitCode::SUCCESS
+        }
+        Err(f) => {
+            report(&f.warnings, &c.sources, format);
+            report(std::slice::from_ref(&f.diagnostic), &c.sources, format);
+            if format == Format::Human {
+                eprintln!(
+                    "{} rows written before the failure{}",
+                    f.rows,
+                    output.map(|p| format!(" to {p}")).unwrap_or_default()
+                );
+            }
+            ExitCode::from(EXIT_RUNTIME)
+        }
+    }
+}

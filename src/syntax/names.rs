@@ -1,0 +1,52 @@
+//! Readable names for every grammar rule, used in "expected ..." messages.
+
+use super::parse::Rule;
+
+/// The name of a rule as a user reads it. Exhaustive: a new rule must be named here.
+pub fn rule_name(rule: Rule) -> &'static str {
+    match rule {
+        Rule::EOI => "end of file",
+        Rule::WHITESPACE => "whitespace",
+        Rule::COMMENT => "a comment",
+        Rule::file => "a model file",
+        Rule::item => "a declaration",
+        Rule::keyword => "a keyword",
+        Rule::ident => "a name",
+        Rule::string | Rule::string_inner => "a quoted string",
+        Rule::model_decl => "`model NAME \"title\"`",
+        Rule::param_decl => "`param NAME = value`",
+        Rule::gravity_decl => "`gravity = (x, y, z) m/s^2`",
+        Rule::ground_decl => "`ground NAME`",
+        Rule::point_mass_decl => "`point_mass NAME { ... }`",
+        Rule::joint_decl => "`joint NAME = KIND(marker, marker) { ... }`",
+        Rule::output_decl => "`output PATH, ...`",
+        Rule::solve_decl => "`solve METHOD(...) { ... }`",
+        Rule::prop_block => "a `{ name = value, ... }` block",
+        Rule::prop => "`name = value`",
+        Rule::solve_args => "solver arguments `(name = value, ...)`",
+        Rule::marker => "a marker `body` or `body @ (x, y, z)`",
+        Rule::output_item => "an output `path` or `name = path`",
+        Rule::path => "a name or a dotted path",
+        Rule::expr | Rule::expr_only => "an expression",
+        Rule::set_arg => "`NAME=VALUE`",
+        Rule::add => "`+`",
+        Rule::sub => "`-`",
+        Rule::mul => "`*`",
+        Rule::div => "`/`",
+        Rule::pow => "`^`",
+        Rule::neg => "`-`",
+        Rule::primary => "a value",
+        Rule::vector | Rule::vector_body => "a vector `(x, y, z)`",
+        Rule::call => "a function call",
+        Rule::quantity => "a number with an optional unit",
+        Rule::number => "a number",
+        Rule::inline_ws => "a space",
+        Rule::unit => "a unit",
+        Rule::unit_op => "`*` or `/` in a unit",
+        Rule::unit_factor | Rule::unit_name => "a unit name",
+        Rule::unit_exp => "an integer exponent",
+        Rule::infix => "an operator",
+        Rule::prefix => "a sign",
+        Rule::ident_char => "a letter, digit or `_`",
+    }
+}

@@ -1,0 +1,366 @@
+//! The pest parser and the conversion of its pairs into the typed AST.
+
+use super::ast::*;
+use super::names::rule_name;
+use crate::diagnostics::{Code, Diagnostic};
+use crate::source::{SourceId, Span};
+use pest::iterators::{Pair, Pairs};
+use pest::pratt_parser::{Assoc, Op, PrattParser};
+use pest::Parser;
+use std::sync::OnceLock;
+
+#[derive(pest_derive::Parser)]
+#[grammar = "../grammar/mbd.pest"]
+struct MbdParser;
+
+fn pratt() -> &'static PrattParser<Rule> {
+    static PRATT: OnceLock<PrattParser<Rule>> = OnceLock::new();
+    PRATT.get_or_init(|| {
+        PrattParser::new()
+            .op(Op::infix(Rule::add, Assoc::Left) | Op::infix(Rule::sub, Assoc::Left))
+            .op(Op::infix(Rule::mul, Assoc::Left) | Op::infix(Rule::div, Assoc::Left))
+            .op(Op::prefix(Rule::neg))
+            .op(Op::infix(Rule::pow, Assoc::Right))
+    })
+}
+
+/// Parses a whole model file.
+pub fn parse_file(text: &str, source: SourceId) -> Result<File, Diagnostic> {
+    let mut pairs = MbdParser::parse(Rule::file, text).map_err(|e| syntax_error(e, source))?;
+    let file = pairs
+        .next()
+        .ok_or_else(|| Diagnostic::error(Code::E0101, "empty parse"))?;
+    let cx = Cx { source };
+    let span = cx.span(&file);
+    let items = file
+        .into_inner()
+        .filter(|p| p.as_rule() != Rule::EOI)
+        .map(|p| cx.item(p))
+        .collect();
+    Ok(File { items, span })
+}
+
+/// Parses a standalone expression, such as the VALUE of `--set NAME=VALUE`.
+pub fn parse_expr(text: &str, source: SourceId) -> Result<Expr, Diagnostic> {
+    let mut pairs = MbdParser::parse(Rule::expr_only, text).map_err(|e| syntax_error(e, source))?;
+    let cx = Cx { source };
+    let top = pairs.next().and_then(|p| p.into_inner().next());
+    match top {
+        Some(e) => Ok(cx.expr(e)),
+        None => Err(Diagnostic::error(Code::E0101, "expected an expression")),
+    }
+}
+
+/// Parses a `--set` argument `NAME=VALUE` held as its own source text.
+pub fn parse_set_arg(text: &str, source: SourceId) -> Result<(Ident, Expr), Diagnostic> {
+    let mut pairs = MbdParser::parse(Rule::set_arg, text).map_err(|e| syntax_error(e, source))?;
+    let cx = Cx { source };
+    let mut it = pairs
+        .next()
+        .map(|p| p.into_inner())
+        .ok_or_else(|| Diagnostic::error(Code::E0101, "expected NAME=VALUE"))?;
+    match (it.next(), it.next()) {
+        (Some(name), Some(value)) => Ok((cx.ident(name), cx.expr(value))),
+        _ => Err(Diagnostic::error(Code::E0101, "expected NAME=VALUE")),
+    }
+}
+
+/// Checks that `text` matches `rule` completely (used by the grammar tests).
+pub fn parse_rule(rule: Rule, text: &str) -> bool {
+    match MbdParser::parse(rule, text) {
+        Ok(mut pairs) => pairs
+            .next()
+            .map(|p| p.as_span().end() == text.len())
+            .unwrap_or(false),
+        Err(_) => false,
+    }
+}
+
+fn syntax_error(e: pest::error::Error<Rule>, source: SourceId) -> Diagnostic {
+    use pest::error::{ErrorVariant, InputLocation};
+    let (start, end) = match e.location {
+        InputLocation::Pos(p) => (p, p),
+        InputLocation::Span((a, b)) => (a, b),
+    };
+    let expected = match &e.variant {
+        ErrorVariant::ParsingError { positives, .. } => {
+            let mut names: Vec<&str> = positives
+                .iter()
+                .filter(|r| !matches!(r, Rule::WHITESPACE | Rule::COMMENT | Rule::inline_ws))
+                .map(|r| rule_name(*r))
+                .collect();
+            names.sort();
+            names.dedup();
+            names
+        }
+        ErrorVariant::CustomError { .. } => Vec::new(),
+    };
+    let message = if expected.is_empty() {
+        "unexpected text".to_string()
+    } else {
+        format!("expected {}", join_or(&expected))
+    };
+    Diagnostic::error(Code::E0101, format!("syntax error: {message}"))
+        .at(Span::new(source, start, end.max(start)), "here")
+        .hint(syntax_hint(&expected))
+}
+
+fn syntax_hint(expected: &[&str]) -> String {
+    if expected.contains(&"a declaration") || expected.iter().any(|e| e.starts_with("`model")) {
+        "a file is a list of declarations: model, param, gravity, ground, point_mass, joint, output, solve"
+            .to_string()
+    } else if expected.contains(&"an expression") || expected.contains(&"a value") {
+        "write a value here: a number with an optional unit (`0.5 m`), a param name, a vector `(x, y, z)` or a call".to_string()
+    } else {
+        "check the declaration against the examples in README.md".to_string()
+    }
+}
+
+fn join_or(items: &[&str]) -> String {
+    match items.len() {
+        0 => String::new(),
+        1 => items[0].to_string(),
+        n => format!("{} or {}", items[..n - 1].join(", "), items[n - 1]),
+    }
+}
+
+struct Cx {
+    source: SourceId,
+}
+
+impl Cx {
+    fn span(&self, p: &Pair<Rule>) -> Span {
+        let s = p.as_span();
+        Span::new(self.source, s.start(), s.end())
+    }
+
+    fn ident(&self, p: Pair<Rule>) -> Ident {
+        Ident {
+            name: p.as_str().to_string(),
+            span: self.span(&p),
+        }
+    }
+
+    fn item(&self, p: Pair<Rule>) -> Item {
+        let span = self.span(&p);
+        let rule = p.as_rule();
+        let mut it = p.into_inner().peekable();
+        match rule {
+            Rule::model_decl => {
+                let name = self.ident(it.next().expect("grammar: model name"));
+                let title = it.next().map(|s| s.into_inner().as_str().to_string());
+                Item::Model { name, title, span }
+            }
+            Rule::param_decl => {
+                let name = self.ident(it.next().expect("grammar: param name"));
+                let value = self.expr(it.next().expect("grammar: param value"));
+                Item::Param { name, value, span }
+            }
+            Rule::gravity_decl => Item::Gravity {
+                value: self.expr(it.next().expect("grammar: gravity")),
+                span,
+            },
+            Rule::ground_decl => Item::Ground {
+                name: self.ident(it.next().expect("grammar: ground name")),
+                span,
+            },
+            Rule::point_mass_decl => {
+                let name = self.ident(it.next().expect("grammar: body name"));
+                let props = self.props(it.next().expect("grammar: block").into_inner());
+                Item::PointMass { name, props, span }
+            }
+            Rule::joint_decl => {
+                let name = self.ident(it.next().expect("grammar: joint name"));
+                let kind = self.ident(it.next().expect("grammar: joint kind"));
+                let mut markers = Vec::new();
+                let mut props = Vec::new();
+                for q in it {
+                    match q.as_rule() {
+                        Rule::marker => markers.push(self.marker(q)),
+                        _ => props = self.props(q.into_inner()),
+                    }
+                }
+                Item::Joint {
+                    name,
+                    kind,
+                    markers,
+                    props,
+                    span,
+                }
+            }
+            Rule::output_decl => Item::Output {
+                items: it.map(|q| self.output_item(q)).collect(),
+                span,
+            },
+            Rule::solve_decl => {
+                let method = self.ident(it.next().expect("grammar: solver"));
+                let mut args = Vec::new();
+                let mut props = Vec::new();
+                for q in it {
+                    match q.as_rule() {
+                        Rule::solve_args => args = self.props(q.into_inner()),
+                        _ => props = self.props(q.into_inner()),
+                    }
+                }
+                Item::Solve {
+                    method,
+                    args,
+                    props,
+                    span,
+                }
+            }
+            r => unreachable!("grammar: unexpected item rule {r:?}"),
+        }
+    }
+
+    fn props(&self, pairs: Pairs<Rule>) -> Vec<Prop> {
+        pairs
+            .map(|p| {
+                let mut it = p.into_inner();
+                let name = self.ident(it.next().expect("grammar: property name"));
+                let value = self.expr(it.next().expect("grammar: property value"));
+                Prop { name, value }
+            })
+            .collect()
+    }
+
+    fn path(&self, p: Pair<Rule>) -> Path {
+        let span = self.span(&p);
+        Path {
+            segments: p.into_inner().map(|s| self.ident(s)).collect(),
+            span,
+        }
+    }
+
+    fn marker(&self, p: Pair<Rule>) -> MarkerRef {
+        let span = self.span(&p);
+        let mut it = p.into_inner();
+        let path = self.path(it.next().expect("grammar: marker path"));
+        let offset = it.next().map(|e| self.expr(e));
+        MarkerRef { path, offset, span }
+    }
+
+    fn output_item(&self, p: Pair<Rule>) -> OutputItem {
+        let span = self.span(&p);
+        let mut name = None;
+        let mut path = None;
+        for q in p.into_inner() {
+            match q.as_rule() {
+                Rule::ident => name = Some(self.ident(q)),
+                _ => path = Some(self.path(q)),
+            }
+        }
+        OutputItem {
+            name,
+            path: path.expect("grammar: output path"),
+            span,
+        }
+    }
+
+    fn expr(&self, p: Pair<Rule>) -> Expr {
+        pratt()
+            .map_primary(|q| self.primary(q))
+            .map_prefix(|op, rhs| {
+                let span = self.span(&op).to(rhs.span);
+                Expr {
+                    kind: ExprKind::Neg {
+                        operand: Box::new(rhs),
+                    },
+                    span,
+                }
+            })
+            .map_infix(|lhs, op, rhs| {
+                let op = match op.as_rule() {
+                    Rule::add => BinOp::Add,
+                    Rule::sub => BinOp::Sub,
+                    Rule::mul => BinOp::Mul,
+                    Rule::div => BinOp::Div,
+                    _ => BinOp::Pow,
+                };
+                let span = lhs.span.to(rhs.span);
+                Expr {
+                    kind: ExprKind::Binary {
+                        op,
+                        lhs: Box::new(lhs),
+                        rhs: Box::new(rhs),
+                    },
+                    span,
+                }
+            })
+            .parse(p.into_inner())
+    }
+
+    fn primary(&self, p: Pair<Rule>) -> Expr {
+        let span = self.span(&p);
+        match p.as_rule() {
+            Rule::quantity => {
+                let mut it = p.into_inner();
+                let number = it.next().expect("grammar: number");
+                let value = number.as_str().parse::<f64>().unwrap_or(f64::NAN);
+                let unit = it.next().map(|u| self.unit(u));
+                Expr {
+                    kind: ExprKind::Quantity { value, unit },
+                    span,
+                }
+            }
+            Rule::vector => {
+                let mut it = p.into_inner();
+                let body = it.next().expect("grammar: vector body");
+                let items = body.into_inner().map(|e| self.expr(e)).collect();
+                let unit = it.next().map(|u| self.unit(u));
+                Expr {
+                    kind: ExprKind::Vector { items, unit },
+                    span,
+                }
+            }
+            Rule::call => {
+                let mut it = p.into_inner();
+                let function = self.ident(it.next().expect("grammar: function name"));
+                let args = it.map(|e| self.expr(e)).collect();
+                Expr {
+                    kind: ExprKind::Call { function, args },
+                    span,
+                }
+            }
+            Rule::path => Expr {
+                kind: ExprKind::Path { path: self.path(p) },
+                span,
+            },
+            Rule::expr => {
+                let inner = self.expr(p);
+                Expr {
+                    kind: inner.kind,
+                    span,
+                }
+            }
+            r => unreachable!("grammar: unexpected primary {r:?}"),
+        }
+    }
+
+    fn unit(&self, p: Pair<Rule>) -> UnitExpr {
+        let span = self.span(&p);
+        let mut factors = Vec::new();
+        let mut op = UnitOp::Mul;
+        for q in p.into_inner() {
+            match q.as_rule() {
+                Rule::unit_op => {
+                    op = if q.as_str() == "/" {
+                        UnitOp::Div
+                    } else {
+                        UnitOp::Mul
+                    }
+                }
+                _ => {
+                    let mut it = q.into_inner();
+                    let name = self.ident(it.next().expect("grammar: unit name"));
+                    let exponent = it
+                        .next()
+                        .and_then(|e| e.as_str().parse::<i32>().ok())
+                        .unwrap_or(1);
+                    factors.push(UnitFactor { op, name, exponent });
+                }
+            }
+        }
+        UnitExpr { factors, span }
+    }
+}

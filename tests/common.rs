@@ -1,0 +1,46 @@
+//! Helpers shared by the integration tests.
+
+use mbd::model::Overrides;
+use std::path::PathBuf;
+
+pub fn repo(path: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join(path)
+}
+
+pub fn read(path: &str) -> String {
+    std::fs::read_to_string(repo(path)).unwrap_or_else(|e| panic!("cannot read {path}: {e}"))
+}
+
+/// A simulated trajectory: column names and rows.
+pub struct Trace {
+    pub header: Vec<String>,
+    pub rows: Vec<Vec<f64>>,
+}
+
+impl Trace {
+    pub fn col(&self, name: &str) -> Vec<f64> {
+        let k = self
+            .header
+            .iter()
+            .position(|h| h == name)
+            .unwrap_or_else(|| panic!("no column {name} in {:?}", self.header));
+        self.rows.iter().map(|r| r[k]).collect()
+    }
+}
+
+/// Compiles and runs a shipped model through the library API, as `mbd run` does.
+pub fn simulate(model: &str, sets: &[&str], overrides: Overrides) -> Trace {
+    let text = read(model);
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let compiled = match mbd::compile(model, &text, &sets, overrides) {
+        Ok(c) => c,
+        Err(f) => panic!("{model} does not compile: {:?}", f.diagnostics),
+    };
+    let mut out = Vec::new();
+    if let Err(f) = mbd::run(&compiled, &mut out) {
+        panic!("{model} failed: {}", f.diagnostic.message);
+    }
+    let (header, rows) =
+        mbd::output::read_csv(&String::from_utf8(out).expect("utf-8 CSV")).expect("CSV");
+    Trace { header, rows }
+}

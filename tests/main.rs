@@ -1,0 +1,8 @@
+//! One integration-test binary (keeps link time down); each module is one concern.
+
+mod architecture;
+mod cli;
+mod common;
+mod diagnostics;
+mod grammar;
+mod pendulum;
