@@ -263,67 +263,54 @@ impl Builder<'_> {
         }
     }
 
+    /// Evaluates `e` and checks its shape (vector or scalar) and dimension.
+    fn typed(&mut self, e: &Expr, dim: Dim, what: &str, vector: bool) -> Option<Value> {
+        let v = self.value(e)?;
+        let is_vector = matches!(v, Value::Vector { .. });
+        let error = if is_vector != vector {
+            let (want, found) = if vector {
+                ("a vector `(x, y, z)`", "scalar")
+            } else {
+                ("a scalar", "vector")
+            };
+            Diagnostic::error(
+                Code::E0209,
+                format!("{what} must be {want}, found a {found}"),
+            )
+            .at(e.span, format!("this is a {found}"))
+        } else if v.dim() != dim {
+            Diagnostic::error(
+                Code::E0202,
+                format!(
+                    "{what} must be a {}, found a {}",
+                    dim.describe(),
+                    v.dim().describe()
+                ),
+            )
+            .at(e.span, format!("this is a {}", v.dim().describe()))
+        } else {
+            return Some(v);
+        };
+        let hint = if vector && !is_vector {
+            format!("write `(x, y, z)`; {}", unit_hint(dim))
+        } else {
+            unit_hint(dim)
+        };
+        self.sink.push(error.hint(hint));
+        None
+    }
+
     fn scalar(&mut self, e: &Expr, dim: Dim, what: &str) -> Option<f64> {
-        match self.value(e)? {
-            Value::Scalar { value, dim: d } if d == dim => Some(value),
-            Value::Scalar { dim: d, .. } => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0202,
-                        format!(
-                            "{what} must be a {}, found a {}",
-                            dim.describe(),
-                            d.describe()
-                        ),
-                    )
-                    .at(e.span, format!("this is a {}", d.describe()))
-                    .hint(unit_hint(dim)),
-                );
-                None
-            }
-            Value::Vector { .. } => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0209,
-                        format!("{what} must be a scalar, found a vector"),
-                    )
-                    .at(e.span, "this is a vector")
-                    .hint(unit_hint(dim)),
-                );
-                None
-            }
+        match self.typed(e, dim, what, false)? {
+            Value::Scalar { value, .. } => Some(value),
+            Value::Vector { .. } => None,
         }
     }
 
     fn vector(&mut self, e: &Expr, dim: Dim, what: &str) -> Option<[f64; 3]> {
-        match self.value(e)? {
-            Value::Vector { value, dim: d } if d == dim => Some(value),
-            Value::Vector { dim: d, .. } => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0202,
-                        format!(
-                            "{what} must be a {}, found a {}",
-                            dim.describe(),
-                            d.describe()
-                        ),
-                    )
-                    .at(e.span, format!("this is a {}", d.describe()))
-                    .hint(unit_hint(dim)),
-                );
-                None
-            }
-            Value::Scalar { .. } => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0209,
-                        format!("{what} must be a vector `(x, y, z)`, found a scalar"),
-                    )
-                    .at(e.span, "this is a scalar")
-                    .hint(format!("write `(x, y, z)`; {}", unit_hint(dim))),
-                );
-                None
-            }
+        match self.typed(e, dim, what, true)? {
+            Value::Vector { value, .. } => Some(value),
+            Value::Scalar { .. } => None,
         }
     }
 

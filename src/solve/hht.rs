@@ -121,6 +121,33 @@ impl<'s> Hht<'s> {
         self.lu.solve(rhs_and_x).map_err(|e| self.singular(e))
     }
 
+    /// The smallest mass-weighted correction `dx` of the coordinates that cancels the current
+    /// constraint values `g` to first order: `[M, s B^T; s B, 0] [dx; nu] = [0; -s g]`.
+    /// Multiplier entries of the result are zero.
+    fn constraint_correction(&mut self) -> Result<Vec<f64>, StepFailure> {
+        let s = self.aug.s;
+        let mut x: Vec<f64> = self
+            .sys
+            .unknowns
+            .iter()
+            .zip(&self.asm.residual.constraint)
+            .map(|(k, g)| {
+                if *k == UnknownKind::Multiplier {
+                    -s * g
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        self.solve_constrained_mass(&mut x)?;
+        for (xi, k) in x.iter_mut().zip(&self.sys.unknowns) {
+            if *k == UnknownKind::Multiplier {
+                *xi = 0.0;
+            }
+        }
+        Ok(x)
+    }
+
     fn singular(&self, e: LinearError) -> StepFailure {
         StepFailure {
             kind: FailureKind::Singular,
@@ -163,18 +190,8 @@ impl<'s> Hht<'s> {
                 break;
             }
             moved.get_or_insert((worst, who));
-            let mut x = vec![0.0; n];
-            for (i, xi) in x.iter_mut().enumerate() {
-                if is_mult(i) {
-                    *xi = -s * self.asm.residual.constraint[i];
-                }
-            }
-            self.solve_constrained_mass(&mut x)?;
-            for (i, xi) in x.iter().enumerate() {
-                if !is_mult(i) {
-                    self.trial.q[i] += xi;
-                }
-            }
+            let dq = self.constraint_correction()?;
+            self.trial.q.iter_mut().zip(&dq).for_each(|(q, d)| *q += d);
         }
         self.asm.residual(self.sys, &self.trial, self.aug);
         if self.largest_constraint().0 > self.ctol() {
@@ -199,18 +216,8 @@ impl<'s> Hht<'s> {
             * vmax.max(self.sys.length_scale / (self.set.dt * self.set.steps as f64));
         let (worst, who) = self.largest_constraint();
         if worst > vtol {
-            let mut x = vec![0.0; n];
-            for (i, xi) in x.iter_mut().enumerate() {
-                if is_mult(i) {
-                    *xi = -s * self.asm.residual.constraint[i];
-                }
-            }
-            self.solve_constrained_mass(&mut x)?;
-            for (i, xi) in x.iter().enumerate() {
-                if !is_mult(i) {
-                    self.trial.v[i] += xi;
-                }
-            }
+            let dv = self.constraint_correction()?;
+            self.trial.v.iter_mut().zip(&dv).for_each(|(v, d)| *v += d);
             notices.push(Notice {
                 kind: NoticeKind::VelocityProjected,
                 entity: who,
