@@ -311,7 +311,7 @@ fn run(
             report(&r.warnings, &c.sources, format);
             if format == Format::Human {
                 eprintln!(
-                    "{}: {} steps, {} Newton iterations, {} halvings, max |C| {:.2e} m, {} rows{} in {:.3} s",
+                    "{}: {} steps, {} Newton iterations, {} halvings, max |C| {:.2e} m, {} rows{} in {:.1} ms",
                     c.model.name,
                     r.stats.steps,
                     r.stats.newton_iterations,
@@ -319,7 +319,7 @@ fn run(
                     r.stats.max_constraint_violation,
                     r.rows,
                     output.map(|p| format!(" to {p}")).unwrap_or_default(),
-                    started.elapsed().as_secs_f64()
+                    started.elapsed().as_secs_f64() * 1e3
                 );
             }
             ExitCode::SUCCESS
