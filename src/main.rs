@@ -95,6 +95,7 @@ enum Emit {
     Ast,
     Model,
     Dofs,
+    #[value(alias = "system")]
     Ir,
 }
 

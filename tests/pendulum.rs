@@ -290,3 +290,52 @@ fn set_accepts_si_numbers_and_values_with_units() {
     }
     assert_eq!(a.col("vx")[0], 3.0);
 }
+
+/// Runs through the library and returns the run statistics with the trace.
+fn run_with_stats(text: &str, sets: &[&str]) -> (Trace, mbd::solve::RunStats) {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let Ok(c) = mbd::compile("pendulum.mbd", text, &sets, Overrides::default()) else {
+        panic!("compiles")
+    };
+    let mut out = Vec::new();
+    let Ok(report) = mbd::run(&c, &mut out) else {
+        panic!("runs")
+    };
+    let (header, rows) = mbd::output::read_csv(&String::from_utf8_lossy(&out)).expect("CSV");
+    (Trace { header, rows }, report.stats)
+}
+
+#[test]
+fn newton_converges_in_two_solves_per_step() {
+    // With the analytic tangent the first solve lands within the quadratic basin and the second
+    // confirms the increment tolerance; a wrong tangent needs more.
+    let (_, stats) = run_with_stats(&crate::common::read("models/pendulum.mbd"), &[]);
+    assert_eq!(stats.steps, 200);
+    assert_eq!(stats.halvings, 0);
+    assert!(
+        stats.newton_iterations <= 2 * stats.steps,
+        "{} iterations for {} steps",
+        stats.newton_iterations,
+        stats.steps
+    );
+    assert!(stats.max_constraint_violation <= 1e-10 * L);
+}
+
+#[test]
+fn halved_steps_recover_and_stay_accurate() {
+    // A Newton budget of two solves is too small for some over-the-top steps at dt = 0.005 s;
+    // those steps are halved, and the run still follows the exact motion.
+    let text = crate::common::read("models/pendulum.mbd").replace(
+        "solve hht(alpha = -0.1) {",
+        "solve hht(alpha = -0.1, max_iterations = 2) {",
+    );
+    let (trace, stats) = run_with_stats(&text, &["V0=5"]);
+    assert!(stats.halvings > 0, "the budget forces halvings");
+    assert_eq!(
+        trace.rows.len(),
+        201,
+        "rows stay on the requested step grid"
+    );
+    let err = position_error(&trace, &Reference::new(5.0, 0.005, 200));
+    assert!(err < 1e-2, "position error {err:.3e} L");
+}
