@@ -152,3 +152,68 @@ fn every_code_has_an_explanation_and_a_distinct_spelling() {
     }
     assert!(mbd::diagnostics::explain("E9999").is_none());
 }
+
+/// Runs a model and renders what the run reports: warnings, then the failure if any.
+fn run_case(name: &str, text: &str, overrides: Overrides) -> (Vec<Code>, String) {
+    let c = match mbd::compile(name, text, &[], overrides) {
+        Ok(c) => c,
+        Err(f) => panic!("{name} does not compile: {:?}", f.diagnostics),
+    };
+    let mut out = Vec::new();
+    let diags = match mbd::run(&c, &mut out) {
+        Ok(r) => r.warnings,
+        Err(f) => f
+            .warnings
+            .into_iter()
+            .chain(std::iter::once(f.diagnostic))
+            .collect(),
+    };
+    (
+        diags.iter().map(|d| d.code).collect(),
+        render_all(&diags, &c.sources),
+    )
+}
+
+#[test]
+fn runtime_diagnostics_name_when_and_where() {
+    let pendulum = read("models/pendulum.mbd");
+    let budget = pendulum.replace(
+        "solve hht(alpha = -0.1) {",
+        "solve hht(alpha = -0.1, max_iterations = 1) {",
+    );
+    let (codes, text) = run_case("newton_budget.mbd", &budget, Overrides::default());
+    assert_eq!(codes, vec![Code::E0601]);
+    insta::assert_snapshot!("run_newton_failure", text);
+
+    let fet = Overrides {
+        integrator: Some(mbd::model::Integrator::Fet),
+        ..Default::default()
+    };
+    let (codes, text) = run_case("pendulum.mbd", &pendulum, fet);
+    assert_eq!(codes, vec![Code::E0604]);
+    insta::assert_snapshot!("run_fet_unavailable", text);
+
+    let radial = pendulum.replace("velocity = (V0, 0, 0)", "velocity = (V0, -0.05 m/s, 0)");
+    let (codes, text) = run_case(
+        "radial.mbd",
+        &radial,
+        Overrides {
+            steps: Some(2),
+            ..Default::default()
+        },
+    );
+    assert_eq!(codes, vec![Code::W0601]);
+    insta::assert_snapshot!("run_velocity_projected", text);
+
+    let long = pendulum.replace("{ length = L }", "{ length = 0.6 m }");
+    let (codes, text) = run_case(
+        "long_link.mbd",
+        &long,
+        Overrides {
+            steps: Some(2),
+            ..Default::default()
+        },
+    );
+    assert_eq!(codes, vec![Code::W0602]);
+    insta::assert_snapshot!("run_position_projected", text);
+}

@@ -324,6 +324,7 @@ impl<'s> Hht<'s> {
         let ltol = self.set.increment_tolerance * self.sys.length_scale;
         let floor = self.sys.mean_mass() * self.sys.length_scale;
         let mut increment_ok = false;
+        let mut last_increment = f64::NAN;
         let mut last = f64::INFINITY;
         let mut growth = 0;
         for it in 0..=self.set.max_iterations {
@@ -380,8 +381,9 @@ impl<'s> Hht<'s> {
                     kind: FailureKind::NewtonDiverged,
                     entity: Some(self.sys.owners[worst.1]),
                     detail: format!(
-                        "Newton {} after {it} iterations (residual {rnorm:.3e} N against a tolerance of {:.3e} N, constraint violation {cnorm:.3e} m)",
+                        "Newton {} after {it} iteration(s), step halved {} time(s) (residual {rnorm:.3e} N against {:.3e} N; constraint violation {cnorm:.3e} m and last increment {last_increment:.3e} m against {ltol:.3e} m)",
                         if growth >= 3 { "diverged" } else { "did not converge" },
+                        self.set.max_halvings,
                         self.set.residual_tolerance * scale
                     ),
                 });
@@ -407,6 +409,7 @@ impl<'s> Hht<'s> {
                 }
             }
             increment_ok = dmax <= ltol;
+            last_increment = dmax;
         }
         Err(StepFailure {
             kind: FailureKind::NewtonDiverged,

@@ -36,7 +36,7 @@ pub fn parse_file(text: &str, source: SourceId) -> Result<File, Diagnostic> {
         .into_inner()
         .filter(|p| p.as_rule() != Rule::EOI)
         .map(|p| cx.item(p))
-        .collect();
+        .collect::<Result<_, _>>()?;
     Ok(File { items, span })
 }
 
@@ -46,7 +46,7 @@ pub fn parse_expr(text: &str, source: SourceId) -> Result<Expr, Diagnostic> {
     let cx = Cx { source };
     let top = pairs.next().and_then(|p| p.into_inner().next());
     match top {
-        Some(e) => Ok(cx.expr(e)),
+        Some(e) => cx.expr(e),
         None => Err(Diagnostic::error(Code::E0101, "expected an expression")),
     }
 }
@@ -60,7 +60,7 @@ pub fn parse_set_arg(text: &str, source: SourceId) -> Result<(Ident, Expr), Diag
         .map(|p| p.into_inner())
         .ok_or_else(|| Diagnostic::error(Code::E0101, "expected NAME=VALUE"))?;
     match (it.next(), it.next()) {
-        (Some(name), Some(value)) => Ok((cx.ident(name), cx.expr(value))),
+        (Some(name), Some(value)) => Ok((cx.ident(name), cx.expr(value)?)),
         _ => Err(Diagnostic::error(Code::E0101, "expected NAME=VALUE")),
     }
 }
@@ -128,6 +128,22 @@ struct Cx {
     source: SourceId,
 }
 
+type Parsed<T> = Result<T, Diagnostic>;
+
+/// The pair the grammar guarantees at this point; an internal error (never a panic) if the
+/// tree and the code ever disagree.
+fn take<'i>(it: &mut impl Iterator<Item = Pair<'i, Rule>>, what: &str) -> Parsed<Pair<'i, Rule>> {
+    it.next().ok_or_else(|| internal(what))
+}
+
+fn internal(what: &str) -> Diagnostic {
+    Diagnostic::error(
+        Code::E0101,
+        format!("internal parser error: missing {what}"),
+    )
+    .hint("this is a bug in mbd's parser; please report it with the model file")
+}
+
 impl Cx {
     fn span(&self, p: &Pair<Rule>) -> Span {
         let s = p.as_span();
@@ -141,43 +157,43 @@ impl Cx {
         }
     }
 
-    fn item(&self, p: Pair<Rule>) -> Item {
+    fn item(&self, p: Pair<Rule>) -> Parsed<Item> {
         let span = self.span(&p);
         let rule = p.as_rule();
-        let mut it = p.into_inner().peekable();
-        match rule {
+        let mut it = p.into_inner();
+        Ok(match rule {
             Rule::model_decl => {
-                let name = self.ident(it.next().expect("grammar: model name"));
+                let name = self.ident(take(&mut it, "model name")?);
                 let title = it.next().map(|s| s.into_inner().as_str().to_string());
                 Item::Model { name, title, span }
             }
             Rule::param_decl => {
-                let name = self.ident(it.next().expect("grammar: param name"));
-                let value = self.expr(it.next().expect("grammar: param value"));
+                let name = self.ident(take(&mut it, "param name")?);
+                let value = self.expr(take(&mut it, "param value")?)?;
                 Item::Param { name, value, span }
             }
             Rule::gravity_decl => Item::Gravity {
-                value: self.expr(it.next().expect("grammar: gravity")),
+                value: self.expr(take(&mut it, "gravity value")?)?,
                 span,
             },
             Rule::ground_decl => Item::Ground {
-                name: self.ident(it.next().expect("grammar: ground name")),
+                name: self.ident(take(&mut it, "ground name")?),
                 span,
             },
             Rule::point_mass_decl => {
-                let name = self.ident(it.next().expect("grammar: body name"));
-                let props = self.props(it.next().expect("grammar: block").into_inner());
+                let name = self.ident(take(&mut it, "body name")?);
+                let props = self.props(take(&mut it, "property block")?.into_inner())?;
                 Item::PointMass { name, props, span }
             }
             Rule::joint_decl => {
-                let name = self.ident(it.next().expect("grammar: joint name"));
-                let kind = self.ident(it.next().expect("grammar: joint kind"));
+                let name = self.ident(take(&mut it, "joint name")?);
+                let kind = self.ident(take(&mut it, "joint kind")?);
                 let mut markers = Vec::new();
                 let mut props = Vec::new();
                 for q in it {
                     match q.as_rule() {
-                        Rule::marker => markers.push(self.marker(q)),
-                        _ => props = self.props(q.into_inner()),
+                        Rule::marker => markers.push(self.marker(q)?),
+                        _ => props = self.props(q.into_inner())?,
                     }
                 }
                 Item::Joint {
@@ -189,17 +205,17 @@ impl Cx {
                 }
             }
             Rule::output_decl => Item::Output {
-                items: it.map(|q| self.output_item(q)).collect(),
+                items: it.map(|q| self.output_item(q)).collect::<Parsed<_>>()?,
                 span,
             },
             Rule::solve_decl => {
-                let method = self.ident(it.next().expect("grammar: solver"));
+                let method = self.ident(take(&mut it, "solver name")?);
                 let mut args = Vec::new();
                 let mut props = Vec::new();
                 for q in it {
                     match q.as_rule() {
-                        Rule::solve_args => args = self.props(q.into_inner()),
-                        _ => props = self.props(q.into_inner()),
+                        Rule::solve_args => args = self.props(q.into_inner())?,
+                        _ => props = self.props(q.into_inner())?,
                     }
                 }
                 Item::Solve {
@@ -209,17 +225,17 @@ impl Cx {
                     span,
                 }
             }
-            r => unreachable!("grammar: unexpected item rule {r:?}"),
-        }
+            _ => return Err(internal("a declaration").at(span, "here")),
+        })
     }
 
-    fn props(&self, pairs: Pairs<Rule>) -> Vec<Prop> {
+    fn props(&self, pairs: Pairs<Rule>) -> Parsed<Vec<Prop>> {
         pairs
             .map(|p| {
                 let mut it = p.into_inner();
-                let name = self.ident(it.next().expect("grammar: property name"));
-                let value = self.expr(it.next().expect("grammar: property value"));
-                Prop { name, value }
+                let name = self.ident(take(&mut it, "property name")?);
+                let value = self.expr(take(&mut it, "property value")?)?;
+                Ok(Prop { name, value })
             })
             .collect()
     }
@@ -232,15 +248,15 @@ impl Cx {
         }
     }
 
-    fn marker(&self, p: Pair<Rule>) -> MarkerRef {
+    fn marker(&self, p: Pair<Rule>) -> Parsed<MarkerRef> {
         let span = self.span(&p);
         let mut it = p.into_inner();
-        let path = self.path(it.next().expect("grammar: marker path"));
-        let offset = it.next().map(|e| self.expr(e));
-        MarkerRef { path, offset, span }
+        let path = self.path(take(&mut it, "marker path")?);
+        let offset = it.next().map(|e| self.expr(e)).transpose()?;
+        Ok(MarkerRef { path, offset, span })
     }
 
-    fn output_item(&self, p: Pair<Rule>) -> OutputItem {
+    fn output_item(&self, p: Pair<Rule>) -> Parsed<OutputItem> {
         let span = self.span(&p);
         let mut name = None;
         let mut path = None;
@@ -250,26 +266,25 @@ impl Cx {
                 _ => path = Some(self.path(q)),
             }
         }
-        OutputItem {
-            name,
-            path: path.expect("grammar: output path"),
-            span,
-        }
+        let path = path.ok_or_else(|| internal("output path").at(span, "here"))?;
+        Ok(OutputItem { name, path, span })
     }
 
-    fn expr(&self, p: Pair<Rule>) -> Expr {
+    fn expr(&self, p: Pair<Rule>) -> Parsed<Expr> {
         pratt()
             .map_primary(|q| self.primary(q))
             .map_prefix(|op, rhs| {
+                let rhs = rhs?;
                 let span = self.span(&op).to(rhs.span);
-                Expr {
+                Ok(Expr {
                     kind: ExprKind::Neg {
                         operand: Box::new(rhs),
                     },
                     span,
-                }
+                })
             })
             .map_infix(|lhs, op, rhs| {
+                let (lhs, rhs) = (lhs?, rhs?);
                 let op = match op.as_rule() {
                     Rule::add => BinOp::Add,
                     Rule::sub => BinOp::Sub,
@@ -278,66 +293,53 @@ impl Cx {
                     _ => BinOp::Pow,
                 };
                 let span = lhs.span.to(rhs.span);
-                Expr {
+                Ok(Expr {
                     kind: ExprKind::Binary {
                         op,
                         lhs: Box::new(lhs),
                         rhs: Box::new(rhs),
                     },
                     span,
-                }
+                })
             })
             .parse(p.into_inner())
     }
 
-    fn primary(&self, p: Pair<Rule>) -> Expr {
+    fn primary(&self, p: Pair<Rule>) -> Parsed<Expr> {
         let span = self.span(&p);
-        match p.as_rule() {
+        let kind = match p.as_rule() {
             Rule::quantity => {
                 let mut it = p.into_inner();
-                let number = it.next().expect("grammar: number");
+                let number = take(&mut it, "number")?;
+                // The grammar admits only valid float syntax; overflow gives inf, caught in eval.
                 let value = number.as_str().parse::<f64>().unwrap_or(f64::NAN);
-                let unit = it.next().map(|u| self.unit(u));
-                Expr {
-                    kind: ExprKind::Quantity { value, unit },
-                    span,
-                }
+                let unit = it.next().map(|u| self.unit(u)).transpose()?;
+                ExprKind::Quantity { value, unit }
             }
             Rule::vector => {
                 let mut it = p.into_inner();
-                let body = it.next().expect("grammar: vector body");
-                let items = body.into_inner().map(|e| self.expr(e)).collect();
-                let unit = it.next().map(|u| self.unit(u));
-                Expr {
-                    kind: ExprKind::Vector { items, unit },
-                    span,
-                }
+                let body = take(&mut it, "vector body")?;
+                let items = body
+                    .into_inner()
+                    .map(|e| self.expr(e))
+                    .collect::<Parsed<_>>()?;
+                let unit = it.next().map(|u| self.unit(u)).transpose()?;
+                ExprKind::Vector { items, unit }
             }
             Rule::call => {
                 let mut it = p.into_inner();
-                let function = self.ident(it.next().expect("grammar: function name"));
-                let args = it.map(|e| self.expr(e)).collect();
-                Expr {
-                    kind: ExprKind::Call { function, args },
-                    span,
-                }
+                let function = self.ident(take(&mut it, "function name")?);
+                let args = it.map(|e| self.expr(e)).collect::<Parsed<_>>()?;
+                ExprKind::Call { function, args }
             }
-            Rule::path => Expr {
-                kind: ExprKind::Path { path: self.path(p) },
-                span,
-            },
-            Rule::expr => {
-                let inner = self.expr(p);
-                Expr {
-                    kind: inner.kind,
-                    span,
-                }
-            }
-            r => unreachable!("grammar: unexpected primary {r:?}"),
-        }
+            Rule::path => ExprKind::Path { path: self.path(p) },
+            Rule::expr => self.expr(p)?.kind,
+            _ => return Err(internal("a value").at(span, "here")),
+        };
+        Ok(Expr { kind, span })
     }
 
-    fn unit(&self, p: Pair<Rule>) -> UnitExpr {
+    fn unit(&self, p: Pair<Rule>) -> Parsed<UnitExpr> {
         let span = self.span(&p);
         let mut factors = Vec::new();
         let mut op = UnitOp::Mul;
@@ -352,7 +354,7 @@ impl Cx {
                 }
                 _ => {
                     let mut it = q.into_inner();
-                    let name = self.ident(it.next().expect("grammar: unit name"));
+                    let name = self.ident(take(&mut it, "unit name")?);
                     let exponent = it
                         .next()
                         .and_then(|e| e.as_str().parse::<i32>().ok())
@@ -361,6 +363,6 @@ impl Cx {
                 }
             }
         }
-        UnitExpr { factors, span }
+        Ok(UnitExpr { factors, span })
     }
 }
