@@ -135,10 +135,14 @@ impl Compiled {
         };
         let mut d = Diagnostic::error(
             code,
-            format!(
-                "{what} at t = {} s (step {}){place}: {}",
-                f.t, f.step, f.detail
-            ),
+            if f.kind == FailureKind::Unsupported {
+                format!("{what}: {}", f.detail)
+            } else {
+                format!(
+                    "{what} at t = {} s (step {}){place}: {}",
+                    f.t, f.step, f.detail
+                )
+            },
         )
         .hint(hint);
         if let Some((e, x)) = entity {
@@ -146,7 +150,7 @@ impl Compiled {
                 d = d.at(*span, format!("{} `{}` declared here", x.kind, x.name));
             }
         } else {
-            d = d.at(self.model.solve.span, "while solving this");
+            d = d.at(self.model.solve.span, "in this solve");
         }
         d
     }
@@ -187,9 +191,7 @@ pub fn run(c: &Compiled, out: &mut dyn Write) -> Result<RunReport, RunFailure> {
             detail: "time finite elements (fet) are not available in this version".to_string(),
         };
         return Err(RunFailure {
-            diagnostic: c
-                .failure_diagnostic(&f)
-                .at(c.model.solve.span, "requested here"),
+            diagnostic: c.failure_diagnostic(&f),
             failure: Some(f),
             warnings: Vec::new(),
             rows: 0,
