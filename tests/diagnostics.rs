@@ -177,43 +177,41 @@ fn run_case(name: &str, text: &str, overrides: Overrides) -> (Vec<Code>, String)
 #[test]
 fn runtime_diagnostics_name_when_and_where() {
     let pendulum = read("models/pendulum.mbd");
-    let budget = pendulum.replace(
-        "solve hht(alpha = -0.1) {",
-        "solve hht(alpha = -0.1, max_iterations = 1) {",
-    );
-    let (codes, text) = run_case("newton_budget.mbd", &budget, Overrides::default());
-    assert_eq!(codes, vec![Code::E0601]);
-    insta::assert_snapshot!("run_newton_failure", text);
-
+    let two_steps = || Overrides {
+        steps: Some(2),
+        ..Default::default()
+    };
     let fet = Overrides {
         integrator: Some(mbd::model::Integrator::Fet),
         ..Default::default()
     };
-    let (codes, text) = run_case("pendulum.mbd", &pendulum, fet);
-    assert_eq!(codes, vec![Code::E0604]);
-    insta::assert_snapshot!("run_fet_unavailable", text);
-
-    let radial = pendulum.replace("velocity = (V0, 0, 0)", "velocity = (V0, -0.05 m/s, 0)");
-    let (codes, text) = run_case(
-        "radial.mbd",
-        &radial,
-        Overrides {
-            steps: Some(2),
-            ..Default::default()
-        },
-    );
-    assert_eq!(codes, vec![Code::W0601]);
-    insta::assert_snapshot!("run_velocity_projected", text);
-
-    let long = pendulum.replace("{ length = L }", "{ length = 0.6 m }");
-    let (codes, text) = run_case(
-        "long_link.mbd",
-        &long,
-        Overrides {
-            steps: Some(2),
-            ..Default::default()
-        },
-    );
-    assert_eq!(codes, vec![Code::W0602]);
-    insta::assert_snapshot!("run_position_projected", text);
+    let cases = [
+        (
+            "run_newton_failure",
+            pendulum.replace(
+                "solve hht(alpha = -0.1) {",
+                "solve hht(alpha = -0.1, max_iterations = 1) {",
+            ),
+            Overrides::default(),
+            Code::E0601,
+        ),
+        ("run_fet_unavailable", pendulum.clone(), fet, Code::E0604),
+        (
+            "run_velocity_projected",
+            pendulum.replace("velocity = (V0, 0, 0)", "velocity = (V0, -0.05 m/s, 0)"),
+            two_steps(),
+            Code::W0601,
+        ),
+        (
+            "run_position_projected",
+            pendulum.replace("{ length = L }", "{ length = 0.6 m }"),
+            two_steps(),
+            Code::W0602,
+        ),
+    ];
+    for (name, text, overrides, code) in cases {
+        let (codes, rendered) = run_case(&format!("{name}.mbd"), &text, overrides);
+        assert_eq!(codes, vec![code], "{name}");
+        insta::assert_snapshot!(name, rendered);
+    }
 }
