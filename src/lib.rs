@@ -18,11 +18,12 @@ pub mod output;
 pub mod runtime;
 pub mod solve;
 pub mod source;
+pub mod stdlib;
 pub mod syntax;
 
 use diagnostics::{Code, Diagnostic, Sink};
 use lower::Provenance;
-use model::{Model, Overrides};
+use model::{Loader, Model, NoFiles, Overrides};
 use runtime::System;
 use solve::{FailureKind, Method, NoticeKind, RunStats, RuntimeFailure, Settings, StartMode};
 use source::SourceMap;
@@ -33,10 +34,16 @@ pub struct Compiled {
     pub sources: SourceMap,
     pub ast: syntax::ast::File,
     pub model: Model,
-    pub system: System,
-    pub provenance: Provenance,
+    /// The runtime system, or why this version cannot simulate the model (E0501).
+    pub lowered: Result<Lowered, Diagnostic>,
     /// Warnings found while compiling.
     pub warnings: Vec<Diagnostic>,
+}
+
+/// The model lowered for the runtime.
+pub struct Lowered {
+    pub system: System,
+    pub provenance: Provenance,
 }
 
 /// Compilation failed: the diagnostics (errors and warnings) and the texts they point into.
@@ -45,12 +52,24 @@ pub struct CompileFailure {
     pub diagnostics: Vec<Diagnostic>,
 }
 
-/// Compiles model text. `sets` are the raw `NAME=VALUE` texts of `--set` flags.
+/// Compiles model text with the built-in standard library only.
+/// `sets` are the raw `NAME=VALUE` texts of `--set` flags.
 pub fn compile(
     name: &str,
     text: &str,
     sets: &[String],
+    overrides: Overrides,
+) -> Result<Compiled, CompileFailure> {
+    compile_with(name, text, sets, overrides, &NoFiles)
+}
+
+/// Compiles model text; `loader` finds the modules it `use`s outside the standard library.
+pub fn compile_with(
+    name: &str,
+    text: &str,
+    sets: &[String],
     mut overrides: Overrides,
+    loader: &dyn Loader,
 ) -> Result<Compiled, CompileFailure> {
     let mut sources = SourceMap::new();
     let id = sources.add(name, text);
@@ -74,7 +93,7 @@ pub fn compile(
             });
         }
     };
-    let model = match model::build(&ast, &overrides, &mut sink) {
+    let model = match model::build(&ast, name, &overrides, &mut sources, loader, &mut sink) {
         Some(m) if !sink.has_errors() => m,
         _ => {
             return Err(CompileFailure {
@@ -83,13 +102,12 @@ pub fn compile(
             })
         }
     };
-    let (system, provenance) = lower::lower(&model);
+    let lowered = lower::lower(&model).map(|(system, provenance)| Lowered { system, provenance });
     Ok(Compiled {
         sources,
         ast,
         model,
-        system,
-        provenance,
+        lowered,
         warnings: sink.diagnostics,
     })
 }
@@ -126,9 +144,12 @@ impl Compiled {
             FailureKind::NonFinite => (Code::E0603, "non-finite values", "try a smaller time step (--dt); check params for extreme values"),
             FailureKind::Unsupported => (Code::E0604, "integrator not available", "use `--integrator hht`"),
         };
+        let Ok(l) = &self.lowered else {
+            return Diagnostic::error(code, what.to_string()).hint(hint);
+        };
         let entity = f
             .entity
-            .and_then(|e| self.system.entities.get(e).map(|x| (e, x)));
+            .and_then(|e| l.system.entities.get(e).map(|x| (e, x)));
         let place = match entity {
             Some((_, x)) => format!("; largest residual in {} `{}`", x.kind, x.name),
             None => String::new(),
@@ -146,7 +167,7 @@ impl Compiled {
         )
         .hint(hint);
         if let Some((e, x)) = entity {
-            if let Some(span) = self.provenance.spans.get(e) {
+            if let Some(span) = l.provenance.spans.get(e) {
                 d = d.at(*span, format!("{} `{}` declared here", x.kind, x.name));
             }
         } else {
@@ -174,7 +195,18 @@ pub struct RunFailure {
 /// Simulates a compiled model, writing CSV rows to `out` as they are computed.
 pub fn run(c: &Compiled, out: &mut dyn Write) -> Result<RunReport, RunFailure> {
     let set = c.settings();
-    let sys = &c.system;
+    let l = match &c.lowered {
+        Ok(l) => l,
+        Err(d) => {
+            return Err(RunFailure {
+                diagnostic: d.clone(),
+                failure: None,
+                warnings: Vec::new(),
+                rows: 0,
+            })
+        }
+    };
+    let sys = &l.system;
     let io_fail = |e: std::io::Error, rows| RunFailure {
         diagnostic: Diagnostic::error(Code::E0603, format!("cannot write the output: {e}"))
             .hint("check the output path and free disk space"),
@@ -223,7 +255,7 @@ pub fn run(c: &Compiled, out: &mut dyn Write) -> Result<RunReport, RunFailure> {
                     NoticeKind::PositionProjected => Code::W0602,
                 };
                 let mut d = Diagnostic::error(code, n.detail).hint(code.doc().to_string());
-                if let Some(span) = n.entity.and_then(|e| c.provenance.spans.get(e)) {
+                if let Some(span) = n.entity.and_then(|e| l.provenance.spans.get(e)) {
                     d = d.at(*span, "this joint");
                 }
                 warnings.push(d);

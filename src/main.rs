@@ -212,7 +212,7 @@ fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> Exi
         Ok(t) => t,
         Err(code) => return code,
     };
-    let c = match mbd::compile(path, &text, sets, Overrides::default()) {
+    let c = match mbd::compile_with(path, &text, sets, Overrides::default(), &FsLoader::new()) {
         Ok(c) => c,
         Err(f) => {
             report(&f.diagnostics, &f.sources, format);
@@ -227,7 +227,13 @@ fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> Exi
         Some(Emit::Ast) => json(serde_json::to_string_pretty(&c.ast)),
         Some(Emit::Model) => json(serde_json::to_string_pretty(&c.model)),
         Some(Emit::Dofs) => json(serde_json::to_string_pretty(&c.model.dofs)),
-        Some(Emit::Ir) => json(serde_json::to_string_pretty(&c.system)),
+        Some(Emit::Ir) => match &c.lowered {
+            Ok(l) => json(serde_json::to_string_pretty(&l.system)),
+            Err(d) => {
+                report(std::slice::from_ref(d), &c.sources, format);
+                return ExitCode::from(EXIT_MODEL);
+            }
+        },
         None => summary(&c, format),
     };
     println!("{out}");
@@ -238,46 +244,84 @@ fn summary(c: &mbd::Compiled, format: Format) -> String {
     let m = &c.model;
     let n = m.dofs.len();
     let mult = m.dofs.multipliers();
-    let pattern = mbd::runtime::Pattern::of(n, &c.system.elements);
+    let nodes = m.bodies.len() + m.beams.iter().map(|b| b.nodes.len()).sum::<usize>();
+    let columns: Vec<&str> = m.outputs.iter().map(|o| o.column.as_str()).collect();
+    let nonzeros = c
+        .lowered
+        .as_ref()
+        .ok()
+        .map(|l| mbd::runtime::Pattern::of(n, &l.system.elements).nnz());
     if format == Format::Json {
         return serde_json::json!({
-            "model": m.name, "bodies": m.bodies.len(), "nodes": m.bodies.len(), "joints": m.joints.len(),
-            "dofs": n - mult, "multipliers": mult, "unknowns": n, "bandwidth": m.dofs.bandwidth,
-            "nonzeros": pattern.nnz(), "channels": c.system.channels.iter().map(|ch| ch.column.clone()).collect::<Vec<_>>(),
-            "steps": m.solve.steps, "dt": m.solve.dt, "until": m.solve.until,
+            "model": m.name, "bodies": m.bodies.len(), "beams": m.beams.len(), "nodes": nodes,
+            "joints": m.joints.len(), "dofs": n - mult - m.dofs.extras(), "extra_unknowns": m.dofs.extras(),
+            "multipliers": mult, "unknowns": n, "bandwidth": m.dofs.bandwidth, "nonzeros": nonzeros,
+            "channels": columns, "steps": m.solve.steps, "dt": m.solve.dt, "until": m.solve.until,
+            "runnable": c.lowered.is_ok(),
         })
         .to_string();
     }
-    let order: Vec<String> = m
-        .dofs
-        .unknowns
-        .iter()
-        .map(|u| match *u {
-            mbd::model::dofs::Unknown::Translation { body, axis } => {
-                format!("{}.u{}", m.bodies[body].name, ["x", "y", "z"][axis])
-            }
-            mbd::model::dofs::Unknown::Multiplier { joint, row } => {
-                format!("{}.lambda{}", m.joints[joint].name, row)
-            }
-        })
-        .collect();
+    let runnable = match &c.lowered {
+        Ok(_) => String::new(),
+        Err(d) => format!("\n  note: {}", d.message),
+    };
     format!(
-        "model {}: ok\n  bodies       {} ({} nodes)\n  joints       {}\n  DOFs         {}\n  multipliers  {}\n  unknowns     {} (order: {})\n  bandwidth    {}\n  nonzeros     {}\n  outputs      t, {}\n  solve        {} steps of {} s to {} s",
+        "model {}: ok\n{}\n  nonzeros     {}\n  outputs      t, {}\n  solve        {} steps of {} s to {} s{runnable}",
         m.name,
-        m.bodies.len(),
-        m.bodies.len(),
-        m.joints.len(),
-        n - mult,
-        mult,
-        n,
-        order.join(" "),
-        m.dofs.bandwidth,
-        pattern.nnz(),
-        c.system.channels.iter().map(|ch| ch.column.as_str()).collect::<Vec<_>>().join(", "),
+        mbd::model::topology::report(m),
+        nonzeros.map(|x| x.to_string()).unwrap_or_else(|| "-".to_string()),
+        columns.join(", "),
         m.solve.steps,
         m.solve.dt,
         m.solve.until
     )
+}
+
+/// Finds `use`d modules next to the importing file, then in the directories of MBD_PATH.
+struct FsLoader {
+    search: Vec<std::path::PathBuf>,
+}
+
+impl FsLoader {
+    fn new() -> FsLoader {
+        let search = std::env::var_os("MBD_PATH")
+            .map(|p| std::env::split_paths(&p).collect())
+            .unwrap_or_default();
+        FsLoader { search }
+    }
+}
+
+impl mbd::model::Loader for FsLoader {
+    fn load(&self, request: &mbd::model::LoadRequest) -> Result<(String, String), Option<String>> {
+        use mbd::model::LoadRequest;
+        let (candidates, from): (Vec<std::path::PathBuf>, &str) = match request {
+            LoadRequest::Module { path, from } => {
+                let mut p = std::path::PathBuf::new();
+                for s in path.iter() {
+                    p.push(s);
+                }
+                p.set_extension("mbd");
+                (vec![p], from)
+            }
+            LoadRequest::File { path, from } => (vec![std::path::PathBuf::from(path)], from),
+        };
+        let here = std::path::Path::new(from)
+            .parent()
+            .map(|p| p.to_path_buf())
+            .unwrap_or_default();
+        for dir in std::iter::once(&here).chain(self.search.iter()) {
+            for c in &candidates {
+                let p = dir.join(c);
+                if p.is_file() {
+                    return match std::fs::read_to_string(&p) {
+                        Ok(text) => Ok((p.display().to_string(), text)),
+                        Err(e) => Err(Some(e.to_string())),
+                    };
+                }
+            }
+        }
+        Err(None)
+    }
 }
 
 fn run(
@@ -291,7 +335,7 @@ fn run(
         Ok(t) => t,
         Err(code) => return code,
     };
-    let c = match mbd::compile(path, &text, sets, overrides) {
+    let c = match mbd::compile_with(path, &text, sets, overrides, &FsLoader::new()) {
         Ok(c) => c,
         Err(f) => {
             report(&f.diagnostics, &f.sources, format);
@@ -299,6 +343,10 @@ fn run(
         }
     };
     report(&c.warnings, &c.sources, format);
+    if let Err(d) = &c.lowered {
+        report(std::slice::from_ref(d), &c.sources, format);
+        return ExitCode::from(EXIT_MODEL);
+    }
     let mut sink: Box<dyn Write> = match output {
         Some(p) => match std::fs::File::create(p) {
             Ok(f) => Box::new(f),

@@ -102,22 +102,58 @@ fn declarations() {
         &["gravity (0, 0, 0)", "gravity ="],
     );
     check(
-        Rule::ground_decl,
-        &["ground earth"],
-        &["ground", "ground 3"],
-    );
-    check(
-        Rule::point_mass_decl,
+        Rule::entity_decl,
         &[
+            "ground earth",
             "point_mass bob { mass = 1 kg, at = (0, 0, 0) m }",
             "point_mass bob {\n mass = m\n at = (0, -L, 0)\n}",
             "point_mass b {}",
+            "rigid_rod blade[i] { from = (0, 0, 0) m, to = (L, 0, 0) }",
+            "beam mast rigid { from = (0, 0, 0) m, to = (0, 0, h) }",
+            "beam mast { section = { EA = 1 N }, elements = 4 }",
+            "force kick on hub.center = (f, 0, 0)",
+            "torque t follower on bar.end = (0, 0, 1) N*m",
+            "spring s(a, b @ (1, 0, 0) m) { stiffness = k }",
+            "rigid hub { marker tip = (1, 0, 0) m, marker root { at = (0, 0, 0) m } }",
         ],
         &[
+            "ground",
+            "ground 3",
             "point_mass { mass = 1 kg }",
             "point_mass bob { mass 1 kg }",
             "point_mass bob mass = 1 kg",
+            "force kick on = 3",
+            "spring s() {}",
         ],
+    );
+    check(
+        Rule::block,
+        &[
+            "{}",
+            "{ a = 1, b = 2 }",
+            "{ a = 1\n b = { c = 2 } }",
+            "{ marker m = (0, 0, 1) m }",
+        ],
+        &["{ a }", "{ a = }", "{ marker }", "{ , }"],
+    );
+    check(
+        Rule::marker_item,
+        &[
+            "marker tip = (L, 0, 0)",
+            "marker tip { at = (1, 0, 0) m, axes = rotate(z, 90 deg) }",
+            "marker m",
+        ],
+        &["marker = 3", "markers tip = 1", "marker 3"],
+    );
+    check(
+        Rule::prop,
+        &[
+            "mass = 1 kg",
+            "torque = ramp(0 s, 1 s) * T0",
+            "section = { EA = 1 N }",
+            "rate = 0.5 rad/s",
+        ],
+        &["mass", "= 3", "mass = ", "2x = 3"],
     );
     check(
         Rule::joint_decl,
@@ -154,6 +190,141 @@ fn declarations() {
 }
 
 #[test]
+fn names_paths_and_markers() {
+    check(
+        Rule::name,
+        &["blade", "blade[i]", "blade[i + 1]"],
+        &["blade[]", "blade [i]", "1blade", "blade[i"],
+    );
+    check(
+        Rule::path,
+        &[
+            "bob",
+            "bob.position.x",
+            "rotor.blade[2].root",
+            "mast.at(1.5 m)",
+            "mast.node[k - 1]",
+            "blade[i].end",
+        ],
+        &["bob.", ".bob", "a..b", "mast.at()", "bob. position"],
+    );
+    check(
+        Rule::marker,
+        &[
+            "earth",
+            "earth @ (e, 0, 0)",
+            "hub @ rotate(z, psi) * (e, 0, 0)",
+            "tower.tip",
+        ],
+        &["@ (0, 0, 0)", "earth @", "earth (1, 2, 3)"],
+    );
+}
+
+#[test]
+fn time_functions() {
+    check(
+        Rule::piecewise,
+        &[
+            "piecewise { 0 s: 0 N, 5 ms: 20 N, 10 ms: 0 N }",
+            "piecewise extrapolate { 0 s: 0, 1 s: 1 }",
+            "piecewise periodic { 0 s: 0, 1 s: 1, }",
+        ],
+        &[
+            "piecewise {}",
+            "piecewise { 0 s 0 N }",
+            "piecewise { 0 s: }",
+            "piecewise 0 s: 1",
+        ],
+    );
+    check(
+        Rule::function_decl,
+        &[
+            "function kick = piecewise { 0 s: 0 N, 5 ms: 20 N, 10 ms: 0 N }",
+            "function w = 2 rad/s * ramp(0 s, 1 s)",
+        ],
+        &["function = 3", "function f", "function f(t) = t"],
+    );
+}
+
+#[test]
+fn components_and_loops() {
+    check(
+        Rule::let_decl,
+        &["let psi = i * 360 deg / N"],
+        &["let = 3", "let x", "let x == 3"],
+    );
+    check(
+        Rule::component_decl,
+        &[
+            "component rod(L: length, m: mass = 1 kg) { rigid_rod bar { from = (0, 0, 0) m, to = (L, 0, 0), mass = m } }",
+            "component c() {}",
+            "component c(a: int,) { export a }",
+        ],
+        &["component c { }", "component c(a) {}", "component c(a: ) {}", "component (a: int) {}"],
+    );
+    check(
+        Rule::comp_param,
+        &["blades: int = 4", "hub: marker", "axis: direction = z"],
+        &["blades", "blades: ", ": int"],
+    );
+    check(
+        Rule::for_decl,
+        &[
+            "for i in 0..N { rigid_rod b[i] {} }",
+            "for i in 1..=blades {}",
+            "for k in 0 .. 2 * N { }",
+        ],
+        &[
+            "for i 0..N {}",
+            "for i in 0..N",
+            "for in 0..3 {}",
+            "for i in 0..3 {",
+        ],
+    );
+    check(
+        Rule::export_decl,
+        &["export hub, blade, lag", "export tip = mast.end"],
+        &["export", "export tip =", "export 3"],
+    );
+    check(
+        Rule::instance_decl,
+        &[
+            "rotor = lag_hinged_rotor(blades = 4, hub = tower.tip)",
+            "t = tower()",
+            "r[i] = rod(L = 1 m,)",
+        ],
+        &[
+            "rotor = lag_hinged_rotor(4)",
+            "rotor = (blades = 4)",
+            "= rotor()",
+            "rotor = a.b(x = 1)",
+        ],
+    );
+    check(
+        Rule::use_decl,
+        &[
+            "use stdlib::rotor::lag_hinged_rotor",
+            "use stdlib::tower",
+            "use \"parts/tower.mbd\"",
+        ],
+        &["use", "use stdlib::", "use ::rotor", "use stdlib.rotor"],
+    );
+    check(
+        Rule::initial_decl,
+        &[
+            "initial spin of rotor = 98.17 rad/s about z through (0, 0, 0) m",
+            "initial spin of beam = Omega about z",
+            "initial velocity of bob = (1, 0, 0) m/s",
+        ],
+        &[
+            "initial spin rotor = 1 rad/s",
+            "initial of rotor = 1",
+            "initial spin of = 1 rad/s",
+        ],
+    );
+}
+
+#[test]
 fn file() {
     check(
         Rule::file,
@@ -162,6 +333,8 @@ fn file() {
             "# only a comment\n",
             "model a\nground g # trailing comment\n",
             "model a ground g",
+            "ground earth\nrigid hub { mass = 1 kg }",
+            "beam b rigid { }\nforce f on b.end = (1, 0, 0) N follower",
         ],
         &[
             "model",

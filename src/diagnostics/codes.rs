@@ -64,7 +64,8 @@ properties it accepts.";
     E0206 = "E0206", "missing property",
         "A declaration lacks a property it needs, for example a `point_mass` without `mass` or `at`.";
     E0207 = "E0207", "circular definition",
-        "A param is defined in terms of itself, directly or through other params.";
+        "A param, a let, a property or an alias is defined in terms of itself, directly or through \
+others.";
     E0208 = "E0208", "unknown --set name",
         "`--set NAME=VALUE` names a param the model does not declare. Only params can be \
 overridden from the command line.";
@@ -75,7 +76,8 @@ have three components.";
         "A call names a function that does not exist, or passes the wrong number of arguments. \
 Functions: sin cos tan asin acos atan atan2 sqrt abs exp ln min max; constant: pi.";
     E0211 = "E0211", "unknown declaration kind",
-        "A joint kind, solver or option value is not known. The hint lists the known ones.";
+        "A declaration kind, joint kind, solver or option value is not known. The hint lists the \
+known ones.";
     E0212 = "E0212", "unknown output quantity",
         "An `output` path does not name a quantity the model can compute. Bodies provide \
 position, velocity and acceleration (and their .x .y .z components); joints provide force and \
@@ -83,22 +85,100 @@ violation.";
     E0213 = "E0213", "invalid value",
         "A value is outside its allowed range or not finite: a negative time step, an HHT alpha \
 outside [-1/3, 0], a division by zero, the square root of a negative number.";
+    E0214 = "E0214", "bad index",
+        "An index is out of range, missing, or given to a name that is not indexed. Loops declare \
+indexed families: `for i in 0..4 { rigid_rod blade[i] { ... } }` declares blade[0] to blade[3]; \
+refer to one member as `blade[2]`. Beams number their nodes from 0: `mast.node[k]`.";
+    E0215 = "E0215", "wrong component argument",
+        "A component is instantiated with an argument it does not declare, without an argument it \
+requires, or with a value of the wrong type (a mass where a length is expected). Arguments are \
+named: `rotor = lag_hinged_rotor(blades = 4, hub = tower.tip, ...)`. The hint lists the \
+parameters and their types.";
+    E0216 = "E0216", "module not found",
+        "A `use` names a module that neither the standard library nor the search path provides. \
+`use stdlib::rotor::lag_hinged_rotor` imports from the built-in standard library; other modules \
+are searched next to the model file and then in the directories listed in MBD_PATH \
+(`use mylib::tower` reads mylib/tower.mbd or mylib.mbd).";
+    E0217 = "E0217", "import cycle",
+        "Two or more modules `use` each other, so none can be loaded first. Move what they share \
+into a third module that imports neither.";
+    E0218 = "E0218", "components nested too deep",
+        "Component instances nest more than 24 levels deep. This almost always means a component \
+instantiates itself, directly or through another component: recursion has no base case in a \
+declarative model.";
+    E0219 = "E0219", "name not exported",
+        "A component declares the name, but its `export` list does not include it, so it is private \
+to the component. Add it to the component's `export` line, or use an exported name.";
+    E0220 = "E0220", "misplaced declaration",
+        "The declaration is not allowed where it is written: `model`, `param`, `gravity` and \
+`solve` belong at the top level of the model file; `component` and `use` may not appear inside \
+a component or a loop; a library file holds components (and the lets, functions and imports \
+they need), not bodies.";
+    E0222 = "E0222", "wrong kind of reference",
+        "A name refers to something of the wrong kind: a joint where a marker is needed, a param \
+where a body is needed, or a body used as a number. Markers are written `body`, `body.marker`, \
+`body @ (x, y, z)` or, on beams, `beam.start`, `beam.end`, `beam.node[k]`, `beam.at(s)`.";
+    E0223 = "E0223", "loop too long",
+        "A `for` loop would run more than 100,000 times; the bounds are probably wrong.";
+    E0224 = "E0224", "wrong declaration shape",
+        "A declaration has parts its kind does not take, or lacks parts it needs: a `force` needs \
+`on MARKER = value`, a `spring` connects two markers `(a, b)`, a `rigid` body takes neither, and \
+a section gives either its full 6x6 `stiffness` or the diagonal stiffnesses, not both.";
     E0301 = "E0301", "joint connects a body to itself",
         "Both markers of a joint are on the same body, so the joint constrains nothing. Connect it \
 to another body or to ground.";
     E0302 = "E0302", "non-positive mass",
-        "A body's mass must be positive. A massless point would make the iteration matrix singular.";
+        "A body's mass must be positive (a rigid body may be massless, mass = 0, if its joints hold \
+it), and a beam section's mass per length must be positive. A massless point would make the \
+iteration matrix singular.";
     E0303 = "E0303", "degenerate joint geometry",
-        "A joint's geometry leaves its constraint undefined, such as a distance joint whose two \
-markers coincide (zero length): its direction is undefined.";
+        "A joint's or a body's geometry is degenerate: a zero axis, a distance joint or a spring \
+whose markers coincide (the direction is undefined), universal-joint axes that are not \
+perpendicular, a rod or a beam of zero length.";
     E0304 = "E0304", "model has no bodies",
         "Nothing moves: declare at least one body.";
     E0305 = "E0305", "joint between two grounds",
         "Both markers of the joint are fixed in the inertial frame, so the joint constrains no \
 unknown.";
     E0306 = "E0306", "invalid marker",
-        "A marker cannot be placed as written, for example with an offset on a point mass, which \
-has no orientation to carry the offset.";
+        "A marker cannot be placed as written: an offset on a point mass (it has no orientation to \
+carry it), a joint that locks the rotation of a point mass, a load on the ground, a point of a \
+beam that does not say which (`start`, `end`, `node[k]`, `at(s)`).";
+    E0307 = "E0307", "redundant constraints",
+        "Some joints lock the same motion: the constraint Jacobian at the initial configuration has \
+lower rank than the number of constraint equations, so the multipliers are not unique and the \
+iteration matrix is singular. The report names the joints whose equations are dependent. A \
+classic case is a four-bar linkage built from revolute joints only (one equation too many in \
+space): make one of them spherical. Two joints between the same pair of bodies are another.";
+    E0308 = "E0308", "motion without inertia or restraint",
+        "Some motion of the model has no mass or inertia and is held by no joint or spring, so the \
+iteration matrix is singular: for instance a massless rigid body attached by a spherical joint \
+only, or a slender rod free to spin about its own axis. Give the motion inertia, or hold it.";
+    E0310 = "E0310", "joint markers do not coincide",
+        "The two points a joint connects are apart at the start (or off the joint's axis, for \
+prismatic and cylindrical joints). Joint equations hold from t = 0, so the bodies must be placed \
+where the joint puts them. Move a body, or move a marker with `body @ (x, y, z)`.";
+    E0311 = "E0311", "non-physical inertia or stiffness",
+        "An inertia tensor has a negative principal moment or breaks the triangle inequality \
+(each principal moment must be at most the sum of the other two), or a section's stiffness matrix \
+is not symmetric positive definite. No real body or beam has such properties.";
+    E0401 = "E0401", "varies in time where a constant is needed",
+        "An expression that depends on `t` (or on a time function) was given where a constant is \
+needed: a mass, a position, a param. Only loads (`force`, `torque`, joint `torque`), prescribed \
+motions (joint `angle`, `rate`) and `function`s may vary in time.";
+    E0402 = "E0402", "time function out of order",
+        "A `piecewise` function's knots are not in increasing time (two knots may share a time to \
+make a jump, three may not), or a `ramp` ends before it starts.";
+    E0403 = "E0403", "unknown piecewise mode",
+        "`piecewise` takes an optional mode that says what happens outside its knots: `hold` (the \
+default: the end values), `extrapolate` (the end slopes continue) or `periodic`.";
+    E0404 = "E0404", "contradictory joint drive",
+        "A joint is both prescribed and loaded (`angle` and `rate`, or `rate` and `torque`), or its \
+prescribed angle is not zero at t = 0. Joint angles are measured from the initial configuration, \
+and a prescribed joint takes whatever torque the motion needs.";
+    E0501 = "E0501", "not supported by this runtime",
+        "The model is valid, but this version of the runtime cannot simulate one of its elements \
+yet. `mbd check` accepts it; `mbd run` will once the runtime supports the element.";
     E0601 = "E0601", "Newton iteration failed",
         "The nonlinear equations of a time step did not converge, even after the step was halved \
 three times. The report names the time, the step and the element with the largest residual. \
@@ -113,6 +193,13 @@ some direction, or constraints may be redundant.";
         "The requested time integrator is not available in this version of mbd. Use `hht`.";
     W0201 = "W0201", "unused param",
         "A param is declared but nothing uses it, not even an output. Remove it, or use it.";
+    W0202 = "W0202", "unused declaration",
+        "A let, a function, a section or a component is declared in the model file but never \
+used. Remove it, or use it.";
+    W0301 = "W0301", "body not connected to ground",
+        "No chain of joints, springs or beams connects the body to a ground, so it floats: the \
+warning names the free motions. That is right for a free-flight test and wrong almost everywhere \
+else; with gravity, the body falls.";
     W0601 = "W0601", "initial velocities projected onto the constraints",
         "The initial velocities violate the joints' velocity constraints. They were projected onto \
 the constraints in the metric of the mass matrix, which is exactly the impulsive response of the \

@@ -4,8 +4,11 @@
 //! elements, outputs into probes, and records for every runtime entity the span it came from.
 //! Raises no user errors: the model stage has caught them.
 
+use crate::diagnostics::{Code, Diagnostic};
 use crate::model::dofs::Unknown;
-use crate::model::{Attach, BodyQuantity, JointKind, JointQuantity, Model, Probe as ModelProbe};
+use crate::model::{
+    Attach, BodyKind, BodyQuantity, JointKind, JointQuantity, Model, Probe as ModelProbe,
+};
 use crate::runtime::{Anchor, Channel, Element, Entity, Probe, State, System, UnknownKind};
 use crate::source::Span;
 
@@ -15,7 +18,54 @@ pub struct Provenance {
     pub spans: Vec<Span>,
 }
 
-pub fn lower(model: &Model) -> (System, Provenance) {
+/// What this version's runtime cannot simulate yet, if anything (E0501, with a span).
+fn unsupported(model: &Model) -> Option<Diagnostic> {
+    let not_yet = |what: String, span: Span| {
+        Some(
+            Diagnostic::error(Code::E0501, format!("{what} cannot be simulated by this version of the runtime"))
+                .at(span, "declared here")
+                .hint("the model is valid (`mbd check` accepts it); this version simulates point masses, distance joints and gravity only"),
+        )
+    };
+    if let Some(b) = model.bodies.iter().find(|b| b.kind == BodyKind::Rigid) {
+        return not_yet(format!("rigid body `{}`", b.name), b.span);
+    }
+    if let Some(b) = model.beams.first() {
+        return not_yet(format!("beam `{}`", b.name), b.span);
+    }
+    if let Some(j) = model
+        .joints
+        .iter()
+        .find(|j| !matches!(j.kind, JointKind::Distance { .. }))
+    {
+        return not_yet(format!("{} joint `{}`", j.kind.name(), j.name), j.span);
+    }
+    if let Some(s) = model.springs.first() {
+        return not_yet(format!("spring `{}`", s.name), s.span);
+    }
+    if let Some(l) = model.loads.first() {
+        return not_yet(format!("load `{}`", l.name), l.span);
+    }
+    if let Some(o) = model.outputs.iter().find(|o| {
+        !matches!(
+            o.probe,
+            ModelProbe::Body {
+                quantity: BodyQuantity::Position
+                    | BodyQuantity::Velocity
+                    | BodyQuantity::Acceleration,
+                ..
+            } | ModelProbe::Joint { .. }
+        )
+    }) {
+        return not_yet(format!("output `{}`", o.column), o.span);
+    }
+    None
+}
+
+pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
+    if let Some(d) = unsupported(model) {
+        return Err(d);
+    }
     let dofs = &model.dofs;
     let n = dofs.len();
     let nb = model.bodies.len();
@@ -47,6 +97,12 @@ pub fn lower(model: &Model) -> (System, Provenance) {
                 unknowns.push(UnknownKind::Multiplier);
                 owners.push(nb + joint);
             }
+            _ => {
+                return Err(Diagnostic::error(
+                    Code::E0501,
+                    "internal: unknown kind not lowered",
+                ))
+            }
         }
     }
     let body_dofs = |b: usize| {
@@ -71,11 +127,13 @@ pub fn lower(model: &Model) -> (System, Provenance) {
     let mut length_scale: f64 = 0.0;
     for (ji, j) in model.joints.iter().enumerate() {
         let anchor = |m: &crate::model::Marker| match m.attach {
-            Attach::Ground(_) => Anchor::Fixed { point: m.offset },
-            Attach::Body(b) => Anchor::Node { dofs: body_dofs(b) },
+            Attach::Body { body } => Anchor::Node {
+                dofs: body_dofs(body),
+            },
+            _ => Anchor::Fixed { point: m.offset },
         };
-        match j.kind {
-            JointKind::Distance { length } => {
+        if let JointKind::Distance { length } = j.kind {
+            {
                 length_scale = length_scale.max(length);
                 elements.push(Element::Distance {
                     a: anchor(&j.markers[0]),
@@ -101,21 +159,24 @@ pub fn lower(model: &Model) -> (System, Provenance) {
                 } => {
                     let index = body_dofs(body)[component];
                     match quantity {
-                        BodyQuantity::Position => Probe::Position { index },
                         BodyQuantity::Velocity => Probe::Velocity { index },
                         BodyQuantity::Acceleration => Probe::Acceleration { index },
+                        _ => Probe::Position { index },
                     }
                 }
-                ModelProbe::Joint { joint, quantity } => match quantity {
+                ModelProbe::Joint {
+                    joint, quantity, ..
+                } => match quantity {
                     JointQuantity::Force => Probe::ConstraintForce {
                         element: nb + joint,
                         row: 0,
                     },
-                    JointQuantity::Violation => Probe::ConstraintViolation {
+                    _ => Probe::ConstraintViolation {
                         element: nb + joint,
                         row: 0,
                     },
                 },
+                _ => Probe::Position { index: 0 },
             };
             Channel {
                 column: o.column.clone(),
@@ -136,5 +197,5 @@ pub fn lower(model: &Model) -> (System, Provenance) {
             1.0
         },
     };
-    (system, Provenance { spans })
+    Ok((system, Provenance { spans }))
 }

@@ -1,117 +1,117 @@
-//! Building the model from the AST: names, properties, units, topology.
+//! Building the model: elaborate the files, then evaluate every declaration into bodies,
+//! beams, joints, springs and loads, then check the topology and number the unknowns.
+//! Every error found is reported; the model is returned only if there are none.
 
-use super::eval::{eval, Value};
-use super::params::{is_secondary, ParamTable};
+use super::elaborate::{unused_bindings, Elaborator};
+use super::env::{is_secondary, BindingKind, Env, Named, ScopeId};
+use super::eval::Value;
 use super::units::Dim;
 use super::*;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic, Sink};
-use crate::syntax::ast::{self, Expr, ExprKind, Item, Prop};
+use crate::source::SourceMap;
+use crate::syntax::ast::{self, Block, Expr, Item, MarkerRef, Prop, PropValue};
 use std::collections::HashMap;
 
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Entity {
+/// What a declaration became.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Built {
     Ground(usize),
     Body(usize),
+    Beam(usize),
+    Section(usize),
     Joint(usize),
+    Spring(usize),
+    Load(usize),
+    Mass,
 }
 
-struct Builder<'a> {
-    sink: &'a mut Sink,
-    params: ParamTable,
-    entities: HashMap<String, (Entity, Span)>,
+/// The parts of an entity declaration.
+pub(super) struct View {
+    pub decl: usize,
+    pub kind: ast::Ident,
+    pub name: String,
+    pub name_span: Span,
+    pub flags: Vec<ast::Ident>,
+    pub markers: Vec<MarkerRef>,
+    pub on: Option<MarkerRef>,
+    pub value: Option<Expr>,
+    pub block: Option<Block>,
+    pub span: Span,
+    pub scope: ScopeId,
 }
+
+pub(super) struct Builder<'s> {
+    pub env: Env,
+    pub sink: &'s mut Sink,
+    pub grounds: Vec<Ground>,
+    pub bodies: Vec<Body>,
+    pub beams: Vec<Beam>,
+    pub sections: Vec<Section>,
+    pub joints: Vec<Joint>,
+    pub springs: Vec<Spring>,
+    pub loads: Vec<Load>,
+    pub built: Vec<Option<Built>>,
+    /// Declaration spans of bodies and beams (for topology messages).
+    pub body_decl: Vec<usize>,
+    pub beam_decl: Vec<usize>,
+}
+
+/// The kinds of entity declarations, for "did you mean".
+pub(super) const KINDS: &[&str] = &[
+    "ground",
+    "point_mass",
+    "rigid",
+    "rigid_rod",
+    "beam",
+    "section",
+    "spring",
+    "damper",
+    "torsional_spring",
+    "torsional_damper",
+    "force",
+    "torque",
+    "concentrated_mass",
+];
 
 /// Builds and checks the model. Every error found is pushed to `sink`; `None` if any.
-pub fn build(file: &ast::File, overrides: &Overrides, sink: &mut Sink) -> Option<Model> {
-    let mut b = Builder {
-        sink,
-        params: ParamTable::new(),
-        entities: HashMap::new(),
-    };
+pub fn build(
+    file: &ast::File,
+    file_name: &str,
+    overrides: &Overrides,
+    sources: &mut SourceMap,
+    loader: &dyn Loader,
+    sink: &mut Sink,
+) -> Option<Model> {
     if file.items.is_empty() {
-        b.sink.push(
+        sink.push(
             Diagnostic::error(Code::E0102, "the model file is empty")
                 .at(file.span, "nothing declared here")
                 .hint("start with `model NAME \"title\"`, then declare a ground, bodies, joints, outputs and a `solve` block (see models/pendulum.mbd)"),
         );
         return None;
     }
-
-    // Pass 1: declare every name, so that order does not matter.
-    let mut header: Option<(String, Option<String>)> = None;
-    let mut grounds = Vec::new();
-    let mut body_items = Vec::new();
-    let mut joint_items = Vec::new();
-    let mut gravity_item: Option<&Expr> = None;
-    let mut solve_item: Option<&Item> = None;
-    let mut output_items = Vec::new();
-    for item in &file.items {
-        match item {
-            Item::Model { name, title, span } => {
-                if header.is_some() {
-                    b.sink.push(
-                        Diagnostic::error(Code::E0103, "a second `model` header")
-                            .at(*span, "repeated here")
-                            .hint("one file describes one model; remove this header"),
-                    );
-                } else {
-                    header = Some((name.name.clone(), title.clone()));
-                }
-            }
-            Item::Param { name, value, span } => {
-                if b.taken(&name.name, name.span)
-                    || !b.params.declare(&name.name, *span, value.clone())
-                {
-                    let first = b.first_span(&name.name);
-                    b.duplicate(name, first);
-                }
-            }
-            Item::Gravity { value, span } => {
-                if gravity_item.is_some() {
-                    b.sink.push(
-                        Diagnostic::error(Code::E0203, "gravity is declared twice")
-                            .at(*span, "second declaration")
-                            .hint("declare `gravity` once"),
-                    );
-                }
-                gravity_item = Some(value);
-            }
-            Item::Ground { name, span } => {
-                if b.declare(name, Entity::Ground(grounds.len())) {
-                    grounds.push(Ground {
-                        name: name.name.clone(),
-                        span: *span,
-                    });
-                }
-            }
-            Item::PointMass { name, props, span } => {
-                if b.declare(name, Entity::Body(body_items.len())) {
-                    body_items.push((name, props, *span));
-                }
-            }
-            Item::Joint {
-                name,
-                kind,
-                markers,
-                props,
-                span,
-            } => {
-                if b.declare(name, Entity::Joint(joint_items.len())) {
-                    joint_items.push((name, kind, markers, props, *span));
-                }
-            }
-            Item::Output { items, .. } => output_items.extend(items.iter()),
-            Item::Solve { span, .. } => {
-                if solve_item.is_some() {
-                    b.sink.push(Diagnostic::error(Code::E0203, "a second `solve` block").at(*span, "repeated here").hint("one model has one `solve` block; override it from the command line with --dt, --until, --alpha"));
-                } else {
-                    solve_item = Some(item);
-                }
-            }
-        }
+    let mut el = Elaborator::new(sources, loader);
+    let top = el.main(&file.items, file_name);
+    let errors = std::mem::take(&mut el.errors);
+    let out = std::mem::replace(
+        &mut el.out,
+        super::elaborate::Elaborated {
+            header: None,
+            gravity: None,
+            solve: None,
+            outputs: Vec::new(),
+            initials: Vec::new(),
+            local_components: Vec::new(),
+            instantiated: Default::default(),
+        },
+    );
+    let env = std::mem::take(&mut el.env);
+    drop(el);
+    for e in errors {
+        sink.push(e);
     }
-    if header.is_none() {
-        b.sink.push(
+    if out.header.is_none() {
+        sink.push(
             Diagnostic::error(Code::E0103, "the file has no `model` header")
                 .at(
                     Span {
@@ -123,163 +123,388 @@ pub fn build(file: &ast::File, overrides: &Overrides, sink: &mut Sink) -> Option
                 .hint("begin the file with `model NAME \"what it is\"`"),
         );
     }
+    let mut b = Builder {
+        built: vec![None; env.decls.len()],
+        env,
+        sink,
+        grounds: Vec::new(),
+        bodies: Vec::new(),
+        beams: Vec::new(),
+        sections: Vec::new(),
+        joints: Vec::new(),
+        springs: Vec::new(),
+        loads: Vec::new(),
+        body_decl: Vec::new(),
+        beam_decl: Vec::new(),
+    };
 
-    // --set overrides name params only.
+    // --set overrides name top-level params only.
     for (name, expr) in &overrides.sets {
-        if !b.params.set_override(&name.name, expr.clone()) {
-            let names = b.params.names();
-            let hint = match did_you_mean(&name.name, names.iter().map(|s| s.as_str())) {
-                Some(s) => format!("did you mean `{s}`? Only params can be set"),
-                None if names.is_empty() => "this model declares no params".to_string(),
-                None => format!("the model's params are: {}", names.join(", ")),
-            };
-            b.sink.push(
-                Diagnostic::error(
-                    Code::E0208,
-                    format!(
-                        "`--set {}`: the model has no param `{}`",
-                        name.name, name.name
-                    ),
-                )
-                .at(name.span, "unknown param")
-                .hint(hint),
-            );
+        match b.env.scopes[top].names.get(&name.name) {
+            Some(Named::Binding(id)) if b.env.bindings[*id].kind == BindingKind::Param => {
+                b.env.bindings[*id].set = Some(expr.clone());
+            }
+            _ => {
+                let names = b.param_names(top);
+                let hint = match did_you_mean(&name.name, names.iter().map(|s| s.as_str())) {
+                    Some(s) => format!("did you mean `{s}`? Only params can be set"),
+                    None if names.is_empty() => "this model declares no params".to_string(),
+                    None => format!("the model's params are: {}", names.join(", ")),
+                };
+                b.sink.push(
+                    Diagnostic::error(
+                        Code::E0208,
+                        format!(
+                            "`--set {}`: the model has no param `{}`",
+                            name.name, name.name
+                        ),
+                    )
+                    .at(name.span, "unknown param")
+                    .hint(hint),
+                );
+            }
         }
     }
 
-    let params = b.params.evaluate_all();
-    let gravity = gravity_item
-        .and_then(|g| b.vector(g, Dim::ACCELERATION, "gravity"))
-        .unwrap_or([0.0; 3]);
-
-    let bodies: Vec<Option<Body>> = body_items
-        .iter()
-        .map(|(n, p, s)| b.point_mass(n, p, *s))
+    // Params, in the order written.
+    let mut params = Vec::new();
+    let mut ids: Vec<usize> = (0..b.env.bindings.len())
+        .filter(|&i| b.env.bindings[i].kind == BindingKind::Param && b.env.bindings[i].scope == top)
         .collect();
-    let joints: Vec<Option<Joint>> = joint_items
-        .iter()
-        .map(|(n, k, m, p, s)| b.joint(n, k, m, p, *s, &body_items))
-        .collect();
-    let outputs = b.outputs(&output_items);
-    let solve = b.solve(solve_item, overrides, file.span);
+    ids.sort_by_key(|&i| b.env.bindings[i].span.start);
+    for id in ids {
+        let used = b.env.bindings[id].used;
+        let span = b.env.bindings[id].span;
+        if let Ok(v) = b.env.value_of(id, span) {
+            params.push((b.env.bindings[id].name.clone(), v));
+        }
+        b.env.bindings[id].used = used;
+    }
+    let gravity = match &out.gravity {
+        Some((g, _)) => b
+            .vector(top, g, Dim::ACCELERATION, "gravity")
+            .unwrap_or([0.0; 3]),
+        None => [0.0; 3],
+    };
 
-    if body_items.is_empty() {
+    // Declarations: sections, then bodies and beams, then what attaches to them.
+    let views: Vec<Option<View>> = (0..b.env.decls.len()).map(|d| b.view(d)).collect();
+    let order = |v: &View| match v.kind.name.as_str() {
+        "section" => 0,
+        "ground" | "point_mass" | "rigid" | "rigid_rod" | "beam" => 1,
+        "concentrated_mass" => 2,
+        _ => 3,
+    };
+    for pass in 0..4 {
+        for v in views.iter().flatten() {
+            if order(v) == pass {
+                b.entity(v);
+            }
+        }
+    }
+    // Joints come after everything they can attach to.
+    for d in 0..b.env.decls.len() {
+        if let Item::Joint { .. } = &*b.env.decls[d].item {
+            b.joint(d);
+        }
+    }
+    for (item, scope) in &out.initials {
+        b.initial(item, *scope);
+    }
+    let outputs = b.outputs(&out.outputs);
+    let solve = b.solve(out.solve.as_ref(), overrides, top, file.span);
+
+    for e in std::mem::take(&mut b.env.errors) {
+        b.sink.push(e);
+    }
+    if b.bodies.is_empty() && b.beams.is_empty() && b.sink.diagnostics.iter().all(|d| !d.is_error())
+    {
         b.sink.push(
             Diagnostic::error(Code::E0304, "the model has no bodies")
                 .at(file.items[0].span(), "in this model")
                 .hint("declare a body, e.g. `point_mass bob { mass = 1 kg, at = (0, -1, 0) m }`"),
         );
     }
-    for e in std::mem::take(&mut b.params.errors) {
+    for e in std::mem::take(&mut b.env.errors) {
         b.sink.push(e);
     }
-    for (name, span) in b.params.unused() {
-        b.sink.push(
-            Diagnostic::error(Code::W0201, format!("param `{name}` is never used"))
-                .at(span, "declared here")
-                .hint("remove it, or use it in a property or an output"),
-        );
-    }
+    b.unused(file.span.source, &out);
     if b.sink.has_errors() {
         return None;
     }
-    let bodies: Vec<Body> = bodies.into_iter().collect::<Option<_>>()?;
-    let mut joints: Vec<Joint> = joints.into_iter().collect::<Option<_>>()?;
-    for j in &mut joints {
-        let JointKind::Distance { length } = &mut j.kind;
-        let d = norm(sub(
-            initial_position(&j.markers[1], &bodies),
-            initial_position(&j.markers[0], &bodies),
-        ));
-        if length.is_nan() {
-            if d < 1e-12 {
-                b.sink.push(Diagnostic::error(Code::E0303, format!("distance joint `{}` starts with coincident markers", j.name)).at(j.span, "zero initial distance, no `length` given").hint("give `length = ...`, or place the bodies apart: a zero-length link has no direction"));
-                return None;
-            }
-            *length = d;
-        }
-    }
-    let (name, title) = header?;
-    let dofs = DofMap::new(&bodies, &joints);
-    Some(Model {
+    let (name, title) = out.header.map(|h| (h.0.name, h.1))?;
+    let mut model = Model {
         name,
         title,
         params,
         gravity,
-        grounds,
-        bodies,
-        joints,
+        grounds: b.grounds,
+        bodies: b.bodies,
+        beams: b.beams,
+        joints: b.joints,
+        springs: b.springs,
+        loads: b.loads,
         outputs,
         solve: solve?,
-        dofs,
-    })
+        dofs: DofMap::default(),
+    };
+    topology::check(&model, b.sink);
+    if b.sink.has_errors() {
+        return None;
+    }
+    model.dofs = DofMap::new(&model);
+    Some(model)
 }
 
 impl Builder<'_> {
-    fn taken(&self, name: &str, _span: Span) -> bool {
-        self.entities.contains_key(name)
+    fn param_names(&self, top: ScopeId) -> Vec<String> {
+        let mut v: Vec<(u32, String)> = self.env.scopes[top]
+            .names
+            .iter()
+            .filter_map(|(k, n)| match n {
+                Named::Binding(id) if self.env.bindings[*id].kind == BindingKind::Param => {
+                    Some((self.env.bindings[*id].span.start, k.clone()))
+                }
+                _ => None,
+            })
+            .collect();
+        v.sort();
+        v.into_iter().map(|x| x.1).collect()
     }
 
-    fn first_span(&self, name: &str) -> Option<Span> {
-        self.entities
-            .get(name)
-            .map(|e| e.1)
-            .or_else(|| self.params.span_of(name))
-    }
-
-    fn duplicate(&mut self, name: &ast::Ident, first: Option<Span>) {
-        let mut d = Diagnostic::error(Code::E0203, format!("`{}` is declared twice", name.name))
-            .at(name.span, "second declaration");
-        if let Some(f) = first {
-            d = d.at(f, "first declared here");
+    fn view(&self, d: usize) -> Option<View> {
+        let decl = &self.env.decls[d];
+        match &*decl.item {
+            Item::Entity {
+                kind,
+                flags,
+                markers,
+                on,
+                value,
+                block,
+                span,
+                ..
+            } => Some(View {
+                decl: d,
+                kind: kind.clone(),
+                name: decl.name.clone(),
+                name_span: decl.name_span,
+                flags: flags.clone(),
+                markers: markers.clone(),
+                on: on.clone(),
+                value: value.clone(),
+                block: block.clone(),
+                span: *span,
+                scope: decl.scope,
+            }),
+            _ => None,
         }
-        self.sink
-            .push(d.hint("every param, ground, body and joint needs its own name"));
     }
 
-    fn declare(&mut self, name: &ast::Ident, e: Entity) -> bool {
-        if self.entities.contains_key(&name.name) || self.params.span_of(&name.name).is_some() {
-            let first = self.first_span(&name.name);
-            self.duplicate(name, first);
-            return false;
-        }
-        self.entities.insert(name.name.clone(), (e, name.span));
-        true
-    }
-
-    fn report(&mut self, d: Diagnostic) {
+    /// Reports an error raised while building something declared in `scope`.
+    pub fn error(&mut self, scope: ScopeId, d: Diagnostic) {
         if !is_secondary(&d) {
+            let d = self.env.trace(scope, d);
             self.sink.push(d);
         }
     }
 
-    fn value(&mut self, e: &Expr) -> Option<Value> {
-        match eval(e, &mut self.params) {
-            Ok(v) => Some(v),
-            Err(d) => {
-                self.report(d);
+    fn entity(&mut self, v: &View) {
+        let built = match v.kind.name.as_str() {
+            "ground" => self.ground(v),
+            "point_mass" => self.point_mass(v),
+            "rigid" => self.rigid(v),
+            "rigid_rod" => self.rigid_rod(v),
+            "beam" => self.beam(v),
+            "section" => self.section_decl(v),
+            "spring" | "damper" | "torsional_spring" | "torsional_damper" => self.spring(v),
+            "force" | "torque" => self.load(v),
+            "concentrated_mass" => self.concentrated_mass(v),
+            other => {
+                let hint = match did_you_mean(other, KINDS.iter().copied()) {
+                    Some(s) => format!("did you mean `{s}`? Declarations: {}", KINDS.join(", ")),
+                    None => format!(
+                        "declarations: {}; joints are written `joint NAME = KIND(a, b)`",
+                        KINDS.join(", ")
+                    ),
+                };
+                self.error(
+                    v.scope,
+                    Diagnostic::error(Code::E0211, format!("unknown declaration kind `{other}`"))
+                        .at(v.kind.span, "not a kind of declaration")
+                        .hint(hint),
+                );
+                None
+            }
+        };
+        self.built[v.decl] = built;
+    }
+
+    /// Checks the parts a declaration has against those its kind takes.
+    pub fn shape(
+        &mut self,
+        v: &View,
+        markers: usize,
+        on: bool,
+        value: bool,
+        flags: &[&str],
+        example: &str,
+    ) -> bool {
+        let mut ok = true;
+        let kind = v.kind.name.clone();
+        let mut bad = |this: &mut Self, span: Span, what: String| {
+            ok = false;
+            this.error(
+                v.scope,
+                Diagnostic::error(Code::E0224, format!("`{kind}` {what}"))
+                    .at(span, "here")
+                    .hint(format!("write it as `{example}`")),
+            );
+        };
+        if v.markers.len() != markers {
+            let span = v.markers.first().map(|m| m.span).unwrap_or(v.name_span);
+            let what = match markers {
+                0 => "does not connect markers".to_string(),
+                n => format!("connects {n} markers, found {}", v.markers.len()),
+            };
+            bad(self, span, what);
+        }
+        match (&v.on, on) {
+            (Some(m), false) => bad(self, m.span, "takes no `on` marker".to_string()),
+            (None, true) => bad(self, v.name_span, "needs `on MARKER`".to_string()),
+            _ => {}
+        }
+        match (&v.value, value) {
+            (Some(e), false) => bad(self, e.span, "takes no `= value`".to_string()),
+            (None, true) => bad(self, v.name_span, "needs `= value`".to_string()),
+            _ => {}
+        }
+        for f in &v.flags {
+            if !flags.contains(&f.name.as_str()) {
+                bad(self, f.span, format!("takes no flag `{}`", f.name));
+            }
+        }
+        ok
+    }
+
+    pub fn has_flag(v: &View, flag: &str) -> bool {
+        v.flags.iter().any(|f| f.name == flag)
+    }
+
+    /// Splits a block by property name, reporting unknown and repeated properties.
+    pub fn props(
+        &mut self,
+        scope: ScopeId,
+        block: Option<&Block>,
+        known: &[&'static str],
+        of: &str,
+    ) -> HashMap<&'static str, Prop> {
+        let mut out: HashMap<&'static str, Prop> = HashMap::new();
+        let Some(block) = block else {
+            return out;
+        };
+        for p in &block.props {
+            match known.iter().find(|k| **k == p.name.name) {
+                Some(&k) => {
+                    if let Some(first) = out.get(k) {
+                        let d =
+                            Diagnostic::error(Code::E0203, format!("property `{k}` is set twice"))
+                                .at(p.name.span, "second value")
+                                .at(first.name.span, "first value")
+                                .hint("set each property once");
+                        self.error(scope, d);
+                    } else {
+                        out.insert(k, p.clone());
+                    }
+                }
+                None => {
+                    let hint = match did_you_mean(&p.name.name, known.iter().copied()) {
+                        Some(s) => format!("did you mean `{s}`? {of} takes: {}", known.join(", ")),
+                        None => format!("{of} takes: {}", known.join(", ")),
+                    };
+                    let d = Diagnostic::error(
+                        Code::E0205,
+                        format!("{of} has no property `{}`", p.name.name),
+                    )
+                    .at(p.name.span, "unknown property")
+                    .hint(hint);
+                    self.error(scope, d);
+                }
+            }
+        }
+        out
+    }
+
+    /// A property's expression; a `{ ... }` block where a value belongs is an error.
+    pub fn expr<'p>(&mut self, scope: ScopeId, p: Option<&'p Prop>) -> Option<&'p Expr> {
+        let p = p?;
+        match &p.value {
+            PropValue::Expr(e) => Some(e),
+            PropValue::Block(b) => {
+                self.error(
+                    scope,
+                    Diagnostic::error(
+                        Code::E0209,
+                        format!("`{}` takes a value, not a block", p.name.name),
+                    )
+                    .at(b.span, "a block")
+                    .hint(format!("write `{} = value`", p.name.name)),
+                );
                 None
             }
         }
     }
 
-    /// Evaluates `e` and checks its shape (vector or scalar) and dimension.
-    fn typed(&mut self, e: &Expr, dim: Dim, what: &str, vector: bool) -> Option<Value> {
-        let v = self.value(e)?;
-        let is_vector = matches!(v, Value::Vector { .. });
-        let error = if is_vector != vector {
-            let (want, found) = if vector {
-                ("a vector `(x, y, z)`", "scalar")
-            } else {
-                ("a scalar", "vector")
-            };
-            Diagnostic::error(
-                Code::E0209,
-                format!("{what} must be {want}, found a {found}"),
+    pub fn missing(&mut self, scope: ScopeId, at: Span, prop: &str, of: &str, example: &str) {
+        self.error(
+            scope,
+            Diagnostic::error(Code::E0206, format!("{of} needs `{prop}`"))
+                .at(at, format!("`{prop}` missing"))
+                .hint(format!("add `{prop} = {example}`")),
+        );
+    }
+
+    pub fn value(&mut self, scope: ScopeId, e: &Expr) -> Option<Value> {
+        match self.env.eval_in(scope, e) {
+            Ok(v) => Some(v),
+            Err(d) => {
+                self.error(scope, d);
+                None
+            }
+        }
+    }
+
+    /// Evaluates `e` as a constant of the given shape and dimension.
+    fn typed(
+        &mut self,
+        scope: ScopeId,
+        e: &Expr,
+        dim: Dim,
+        what: &str,
+        vector: bool,
+    ) -> Option<Value> {
+        let v = self.value(scope, e)?;
+        let error = match (&v, vector) {
+            (Value::Signal { .. }, _) => Diagnostic::error(
+                Code::E0401,
+                format!("{what} must be a constant, found a function of time"),
             )
-            .at(e.span, format!("this is a {found}"))
-        } else if v.dim() != dim {
-            Diagnostic::error(
+            .at(e.span, "this varies in time"),
+            (Value::Scalar { .. }, true)
+            | (Value::Vector { .. }, false)
+            | (Value::Rotation { .. }, _) => {
+                let want = if vector {
+                    "a vector `(x, y, z)`"
+                } else {
+                    "a scalar"
+                };
+                Diagnostic::error(
+                    Code::E0209,
+                    format!("{what} must be {want}, found {}", v.kind_name()),
+                )
+                .at(e.span, format!("this is {}", v.kind_name()))
+            }
+            _ if v.dim() != dim => Diagnostic::error(
                 Code::E0202,
                 format!(
                     "{what} must be a {}, found a {}",
@@ -287,37 +512,135 @@ impl Builder<'_> {
                     v.dim().describe()
                 ),
             )
-            .at(e.span, format!("this is a {}", v.dim().describe()))
-        } else {
-            return Some(v);
+            .at(e.span, format!("this is a {}", v.dim().describe())),
+            _ => return Some(v),
         };
-        let hint = if vector && !is_vector {
+        let hint = if let Value::Signal { .. } = v {
+            "only loads, prescribed motions and functions may depend on `t`".to_string()
+        } else if vector && !matches!(v, Value::Vector { .. }) {
             format!("write `(x, y, z)`; {}", unit_hint(dim))
         } else {
             unit_hint(dim)
         };
-        self.sink.push(error.hint(hint));
+        self.error(scope, error.hint(hint));
         None
     }
 
-    fn scalar(&mut self, e: &Expr, dim: Dim, what: &str) -> Option<f64> {
-        match self.typed(e, dim, what, false)? {
+    pub fn scalar(&mut self, scope: ScopeId, e: &Expr, dim: Dim, what: &str) -> Option<f64> {
+        match self.typed(scope, e, dim, what, false)? {
             Value::Scalar { value, .. } => Some(value),
-            Value::Vector { .. } => None,
+            _ => None,
         }
     }
 
-    fn vector(&mut self, e: &Expr, dim: Dim, what: &str) -> Option<[f64; 3]> {
-        match self.typed(e, dim, what, true)? {
+    pub fn vector(&mut self, scope: ScopeId, e: &Expr, dim: Dim, what: &str) -> Option<[f64; 3]> {
+        match self.typed(scope, e, dim, what, true)? {
             Value::Vector { value, .. } => Some(value),
-            Value::Scalar { .. } => None,
+            _ => None,
         }
     }
 
-    fn integer(&mut self, e: &Expr, what: &str, min: usize) -> Option<usize> {
-        let x = self.scalar(e, Dim::NONE, what)?;
-        if x.fract() != 0.0 || x < min as f64 || x > 1e12 {
-            self.sink.push(
+    /// A non-zero direction, normalised. Any dimension is accepted (`(1, 0, 0)`, `(0, 0, 1) m`).
+    pub fn direction(&mut self, scope: ScopeId, e: &Expr, what: &str) -> Option<[f64; 3]> {
+        let v = self.value(scope, e)?;
+        let Value::Vector { value, .. } = v else {
+            self.error(
+                scope,
+                Diagnostic::error(
+                    Code::E0209,
+                    format!(
+                        "{what} must be a constant direction, found {}",
+                        v.kind_name()
+                    ),
+                )
+                .at(e.span, format!("this is {}", v.kind_name()))
+                .hint("write an axis such as `z` or `(0, 0, 1)`"),
+            );
+            return None;
+        };
+        let n = norm(value);
+        if n == 0.0 {
+            self.error(
+                scope,
+                Diagnostic::error(Code::E0303, format!("{what} is a zero vector"))
+                    .at(e.span, "has no direction")
+                    .hint("give a non-zero axis such as `z` or `(0, 0, 1)`"),
+            );
+            return None;
+        }
+        Some(value.map(|x| x / n))
+    }
+
+    /// A time function (a constant is a constant function) with the given dimension.
+    pub fn signal(
+        &mut self,
+        scope: ScopeId,
+        e: &Expr,
+        dim: Dim,
+        what: &str,
+        vector: bool,
+    ) -> Option<Vec<TimeFn>> {
+        let v = self.value(scope, e)?;
+        let parts = v.parts();
+        let want = if vector { 3 } else { 1 };
+        match parts {
+            Some((p, d)) if p.len() == want && d == dim => Some(p),
+            Some((p, d)) if p.len() == want => {
+                self.error(
+                    scope,
+                    Diagnostic::error(
+                        Code::E0202,
+                        format!(
+                            "{what} must be a {}, found a {}",
+                            dim.describe(),
+                            d.describe()
+                        ),
+                    )
+                    .at(e.span, format!("this is a {}", d.describe()))
+                    .hint(unit_hint(dim)),
+                );
+                None
+            }
+            _ => {
+                let shape = if vector {
+                    "a vector (x, y, z)"
+                } else {
+                    "a scalar"
+                };
+                self.error(
+                    scope,
+                    Diagnostic::error(
+                        Code::E0209,
+                        format!("{what} must be {shape}, found {}", v.kind_name()),
+                    )
+                    .at(e.span, format!("this is {}", v.kind_name()))
+                    .hint(unit_hint(dim)),
+                );
+                None
+            }
+        }
+    }
+
+    pub fn rotation(&mut self, scope: ScopeId, e: &Expr, what: &str) -> Option<Mat3> {
+        match self.value(scope, e)? {
+            Value::Rotation { matrix } => Some(matrix),
+            v => {
+                self.error(
+                    scope,
+                    Diagnostic::error(Code::E0209, format!("{what} must be a rotation, found {}", v.kind_name()))
+                        .at(e.span, format!("this is {}", v.kind_name()))
+                        .hint("write `rotate(axis, angle)`, e.g. `rotate(z, 90 deg)`, or a product of rotations"),
+                );
+                None
+            }
+        }
+    }
+
+    pub fn integer(&mut self, scope: ScopeId, e: &Expr, what: &str, min: usize) -> Option<usize> {
+        let x = self.scalar(scope, e, Dim::NONE, what)?;
+        if x.fract() != 0.0 || x < min as f64 || x > 1e9 {
+            self.error(
+                scope,
                 Diagnostic::error(
                     Code::E0213,
                     format!("{what} must be a whole number of at least {min}"),
@@ -330,611 +653,114 @@ impl Builder<'_> {
         Some(x as usize)
     }
 
-    /// Splits a property list by name, reporting unknown and repeated properties.
-    fn props<'p>(
-        &mut self,
-        props: &'p [Prop],
-        known: &[&'static str],
-        of: &str,
-    ) -> HashMap<&'static str, &'p Prop> {
-        let mut out: HashMap<&'static str, &'p Prop> = HashMap::new();
-        for p in props {
-            match known.iter().find(|k| **k == p.name.name) {
-                Some(&k) => {
-                    if let Some(first) = out.get(k) {
-                        self.sink.push(
-                            Diagnostic::error(Code::E0203, format!("property `{k}` is set twice"))
-                                .at(p.name.span, "second value")
-                                .at(first.name.span, "first value")
-                                .hint("set each property once"),
-                        );
-                    } else {
-                        out.insert(k, p);
-                    }
-                }
-                None => {
-                    let hint = match did_you_mean(&p.name.name, known.iter().copied()) {
-                        Some(s) => format!("did you mean `{s}`? {of} takes: {}", known.join(", ")),
-                        None => format!("{of} takes: {}", known.join(", ")),
-                    };
-                    self.sink.push(
-                        Diagnostic::error(
-                            Code::E0205,
-                            format!("{of} has no property `{}`", p.name.name),
-                        )
-                        .at(p.name.span, "unknown property")
-                        .hint(hint),
-                    );
-                }
-            }
-        }
-        out
-    }
-
-    fn missing(&mut self, at: Span, prop: &str, of: &str, example: &str) {
-        self.sink.push(
-            Diagnostic::error(Code::E0206, format!("{of} needs `{prop}`"))
-                .at(at, format!("`{prop}` missing"))
-                .hint(format!("add `{prop} = {example}`")),
-        );
-    }
-
-    fn point_mass(&mut self, name: &ast::Ident, props: &[Prop], span: Span) -> Option<Body> {
-        let of = format!("point_mass `{}`", name.name);
-        let p = self.props(props, &["mass", "at", "velocity"], "a point_mass");
-        let mass = match p.get("mass") {
-            Some(m) => {
-                let v = self.scalar(&m.value, Dim::MASS, "`mass`");
-                if let Some(x) = v {
-                    if x <= 0.0 {
-                        self.sink.push(Diagnostic::error(Code::E0302, format!("the mass of `{}` is not positive", name.name)).at(m.value.span, format!("{x} kg")).hint("a body needs a positive mass; a massless point makes the iteration matrix singular"));
-                        return None;
-                    }
-                }
-                v
-            }
-            None => {
-                self.missing(name.span, "mass", &of, "1 kg");
-                None
-            }
-        };
-        let position = match p.get("at") {
-            Some(a) => self.vector(&a.value, Dim::LENGTH, "`at`"),
-            None => {
-                self.missing(name.span, "at", &of, "(0, 0, 0) m");
-                None
-            }
-        };
-        let velocity = match p.get("velocity") {
-            Some(v) => self.vector(&v.value, Dim::VELOCITY, "`velocity`"),
-            None => Some([0.0; 3]),
-        };
-        Some(Body {
-            name: name.name.clone(),
-            span,
-            mass: mass?,
-            position: position?,
-            velocity: velocity?,
-        })
-    }
-
-    fn marker(
-        &mut self,
-        m: &ast::MarkerRef,
-        bodies: &[(&ast::Ident, &Vec<Prop>, Span)],
-    ) -> Option<Marker> {
-        let head = &m.path.segments[0];
-        let target = self.entities.get(&head.name).map(|e| e.0);
-        let attach = match target {
-            Some(Entity::Ground(g)) if m.path.segments.len() == 1 => Attach::Ground(g),
-            Some(Entity::Body(b)) if m.path.segments.len() == 1 => Attach::Body(b),
-            Some(Entity::Ground(_)) | Some(Entity::Body(_)) => {
-                self.sink.push(
-                    Diagnostic::error(Code::E0201, format!("`{}` names no marker", m.path.text()))
-                        .at(m.path.span, "unknown marker")
-                        .hint(format!(
-                            "attach to the body itself: `{}` or `{} @ (x, y, z)`",
-                            head.name, head.name
-                        )),
-                );
-                return None;
-            }
-            Some(Entity::Joint(_)) => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0201,
-                        format!("`{}` is a joint, not a body", head.name),
-                    )
-                    .at(head.span, "a joint")
-                    .hint("a joint connects markers on bodies or on a ground"),
-                );
-                return None;
-            }
-            None => {
-                let names: Vec<String> = self
-                    .entities
-                    .iter()
-                    .filter(|(_, e)| !matches!(e.0, Entity::Joint(_)))
-                    .map(|(n, _)| n.clone())
-                    .collect();
-                let hint = match did_you_mean(&head.name, names.iter().map(|s| s.as_str())) {
-                    Some(s) => format!("did you mean `{s}`?"),
-                    None => {
-                        "declare it with `ground NAME` or `point_mass NAME { ... }`".to_string()
-                    }
-                };
-                self.sink.push(
-                    Diagnostic::error(Code::E0201, format!("unknown body `{}`", head.name))
-                        .at(head.span, "not declared")
-                        .hint(hint),
-                );
-                return None;
-            }
-        };
-        let offset = match &m.offset {
-            Some(e) => {
-                if let Attach::Body(b) = attach {
-                    self.sink.push(Diagnostic::error(Code::E0306, format!("a marker on point mass `{}` cannot have an offset", bodies[b].0.name)).at(e.span, "offset given here").hint("a point mass has no orientation: its only marker is the point itself; remove `@ ...`"));
-                    return None;
-                }
-                self.vector(e, Dim::LENGTH, "a marker offset")?
-            }
-            None => [0.0; 3],
-        };
-        Some(Marker {
-            attach,
-            offset,
-            span: m.span,
-        })
-    }
-
-    fn joint(
-        &mut self,
-        name: &ast::Ident,
-        kind: &ast::Ident,
-        markers: &[ast::MarkerRef],
-        props: &[Prop],
-        span: Span,
-        bodies: &[(&ast::Ident, &Vec<Prop>, Span)],
-    ) -> Option<Joint> {
-        const KINDS: &[&str] = &["distance"];
-        if kind.name != "distance" {
-            let hint = match did_you_mean(&kind.name, KINDS.iter().copied()) {
-                Some(s) => format!("did you mean `{s}`? Joint kinds: {}", KINDS.join(", ")),
-                None => format!(
-                    "joint kinds available in this version: {}",
-                    KINDS.join(", ")
-                ),
-            };
-            self.sink.push(
-                Diagnostic::error(Code::E0211, format!("unknown joint kind `{}`", kind.name))
-                    .at(kind.span, "not a joint kind")
-                    .hint(hint),
-            );
-            return None;
-        }
-        if markers.len() != 2 {
-            self.sink.push(
-                Diagnostic::error(
-                    Code::E0209,
-                    format!(
-                        "a distance joint connects 2 markers, found {}",
-                        markers.len()
-                    ),
-                )
-                .at(kind.span, "here")
-                .hint("write `distance(a, b)`"),
-            );
-            return None;
-        }
-        let ms: Vec<Option<Marker>> = markers.iter().map(|m| self.marker(m, bodies)).collect();
-        let p = self.props(props, &["length"], "a distance joint");
-        let length = match p.get("length") {
-            Some(l) => Some((
-                self.scalar(&l.value, Dim::LENGTH, "`length`")?,
-                l.value.span,
-            )),
-            None => None,
-        };
-        let [Some(a), Some(b)] = [ms[0].clone(), ms[1].clone()] else {
-            return None;
-        };
-        match (a.attach, b.attach) {
-            (Attach::Ground(_), Attach::Ground(_)) => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0305,
-                        format!("joint `{}` connects two grounds", name.name),
-                    )
-                    .at(span, "both markers fixed")
-                    .hint("attach at least one marker to a body"),
-                );
-                return None;
-            }
-            (Attach::Body(x), Attach::Body(y)) if x == y => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0301,
-                        format!(
-                            "joint `{}` connects `{}` to itself",
-                            name.name, bodies[x].0.name
-                        ),
-                    )
-                    .at(a.span, "this marker")
-                    .at(b.span, "and this one are on the same body")
-                    .hint("connect the body to another body or to ground"),
-                );
-                return None;
-            }
-            _ => {}
-        }
-        let length = match length {
-            Some((l, s)) if l <= 0.0 => {
-                self.sink.push(Diagnostic::error(Code::E0303, format!("distance joint `{}` has a non-positive length", name.name)).at(s, "must be positive").hint("a distance joint keeps two points a positive distance apart; use a spherical joint to make them coincide"));
-                return None;
-            }
-            Some((l, _)) => l,
-            // Without `length`, the joint keeps the initial distance; checked in the lowering.
-            None => f64::NAN,
-        };
-        Some(Joint {
-            name: name.name.clone(),
-            span,
-            kind: JointKind::Distance { length },
-            markers: [a, b],
-        })
-    }
-
-    fn outputs(&mut self, items: &[&ast::OutputItem]) -> Vec<OutputChannel> {
-        let mut out: Vec<OutputChannel> = Vec::new();
-        let mut columns: HashMap<String, Span> = HashMap::new();
-        columns.insert("t".to_string(), Span::default());
-        for item in items {
-            let Some(probes) = self.probes(&item.path) else {
+    /// Warnings for what the model file declares and never uses.
+    fn unused(&mut self, main: crate::source::SourceId, out: &super::elaborate::Elaborated) {
+        let mut warnings = Vec::new();
+        for b in unused_bindings(&self.env) {
+            if b.span.source != main {
                 continue;
+            }
+            let (code, what, hint) = match b.kind {
+                BindingKind::Param => (
+                    Code::W0201,
+                    "param",
+                    "remove it, or use it in a property or an output",
+                ),
+                BindingKind::Let => (Code::W0202, "let", "remove it, or use it"),
+                BindingKind::Function => (
+                    Code::W0202,
+                    "function",
+                    "remove it, or use it in a load or a prescribed motion",
+                ),
+                _ => continue,
             };
-            let base = item
-                .name
-                .as_ref()
-                .map(|n| n.name.clone())
-                .unwrap_or_else(|| item.path.text());
-            let n = probes.len();
-            for (suffix, probe) in probes {
-                let column = if n == 1 {
-                    base.clone()
-                } else {
-                    format!("{base}.{suffix}")
-                };
-                if let Some(first) = columns.get(&column) {
-                    let mut d = Diagnostic::error(
-                        Code::E0203,
-                        format!("output column `{column}` is declared twice"),
-                    )
-                    .at(item.span, "second column of that name");
-                    if first.end > 0 {
-                        d = d.at(*first, "first declared here");
-                    }
-                    self.sink
-                        .push(d.hint("name the output: `output NAME = PATH`"));
-                    continue;
-                }
-                columns.insert(column.clone(), item.span);
-                out.push(OutputChannel {
-                    column,
-                    probe,
-                    span: item.span,
-                });
-            }
-        }
-        out
-    }
-
-    /// The probes a path names, with column suffixes for vectors.
-    fn probes(&mut self, path: &ast::Path) -> Option<Vec<(&'static str, Probe)>> {
-        let segs = &path.segments;
-        let head = &segs[0];
-        const AXES: [&str; 3] = ["x", "y", "z"];
-        let entity = self.entities.get(&head.name).map(|e| e.0);
-        let bad = |this: &mut Self, at: &ast::Ident, what: &str, known: &[&str]| {
-            let hint = match did_you_mean(&at.name, known.iter().copied()) {
-                Some(s) => format!("did you mean `{s}`? {what} provides: {}", known.join(", ")),
-                None => format!("{what} provides: {}", known.join(", ")),
-            };
-            this.sink.push(
-                Diagnostic::error(
-                    Code::E0212,
-                    format!("`{}` is not an output quantity of {what}", at.name),
-                )
-                .at(at.span, "unknown quantity")
-                .hint(hint),
-            );
-            None
-        };
-        match entity {
-            Some(Entity::Body(b)) => {
-                const Q: &[&str] = &["position", "velocity", "acceleration"];
-                let Some(q) = segs.get(1) else {
-                    return bad(self, head, "a point_mass", Q).or(None);
-                };
-                let quantity = match q.name.as_str() {
-                    "position" => BodyQuantity::Position,
-                    "velocity" => BodyQuantity::Velocity,
-                    "acceleration" => BodyQuantity::Acceleration,
-                    _ => return bad(self, q, "a point_mass", Q),
-                };
-                match segs.get(2) {
-                    None => Some(
-                        AXES.iter()
-                            .enumerate()
-                            .map(|(i, a)| {
-                                (
-                                    *a,
-                                    Probe::Body {
-                                        body: b,
-                                        quantity,
-                                        component: i,
-                                    },
-                                )
-                            })
-                            .collect(),
-                    ),
-                    Some(c) if segs.len() == 3 => match AXES.iter().position(|a| *a == c.name) {
-                        Some(i) => Some(vec![(
-                            "",
-                            Probe::Body {
-                                body: b,
-                                quantity,
-                                component: i,
-                            },
-                        )]),
-                        None => bad(self, c, "a vector", &AXES),
-                    },
-                    Some(_) => bad(self, &segs[3], "a vector component", &[]),
-                }
-            }
-            Some(Entity::Joint(j)) => {
-                const Q: &[&str] = &["force", "violation"];
-                let quantity = match segs.get(1).map(|s| s.name.as_str()) {
-                    Some("force") if segs.len() == 2 => JointQuantity::Force,
-                    Some("violation") if segs.len() == 2 => JointQuantity::Violation,
-                    Some(_) if segs.len() > 2 => {
-                        return bad(self, &segs[2], "a scalar joint quantity", &[])
-                    }
-                    Some(_) => return bad(self, &segs[1], "a distance joint", Q),
-                    None => return bad(self, head, "a distance joint", Q),
-                };
-                Some(vec![("", Probe::Joint { joint: j, quantity })])
-            }
-            Some(Entity::Ground(_)) => {
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0212,
-                        format!("ground `{}` has no output quantities", head.name),
-                    )
-                    .at(path.span, "a ground does not move")
-                    .hint("output a body's position, velocity or acceleration, or a joint's force"),
-                );
-                None
-            }
-            None => {
-                let names: Vec<String> = self.entities.keys().cloned().collect();
-                let hint = match did_you_mean(&head.name, names.iter().map(|s| s.as_str())) {
-                    Some(s) => format!("did you mean `{s}`?"),
-                    None => "outputs name a body or a joint, e.g. `bob.position.x` or `link.force`"
-                        .to_string(),
-                };
-                self.sink.push(
-                    Diagnostic::error(
-                        Code::E0201,
-                        format!("unknown name `{}` in output", head.name),
-                    )
-                    .at(head.span, "not declared")
+            warnings.push(
+                Diagnostic::error(code, format!("{what} `{}` is never used", b.name))
+                    .at(b.span, "declared here")
                     .hint(hint),
-                );
-                None
-            }
-        }
-    }
-
-    fn solve(&mut self, item: Option<&Item>, o: &Overrides, file_span: Span) -> Option<SolveSpec> {
-        let (method, props, span) = match item {
-            Some(Item::Solve {
-                method,
-                args,
-                props,
-                span,
-            }) => (
-                Some(method),
-                args.iter()
-                    .chain(props.iter())
-                    .cloned()
-                    .collect::<Vec<Prop>>(),
-                *span,
-            ),
-            _ => (
-                None,
-                Vec::new(),
-                Span {
-                    end: file_span.start,
-                    ..file_span
-                },
-            ),
-        };
-        let mut integrator = Integrator::Hht;
-        if let Some(m) = method {
-            integrator = match m.name.as_str() {
-                "hht" => Integrator::Hht,
-                "fet" => Integrator::Fet,
-                other => {
-                    let hint = match did_you_mean(other, ["hht", "fet"]) {
-                        Some(s) => format!("did you mean `{s}`? Solvers: hht, fet"),
-                        None => "solvers: hht (HHT-alpha), fet (time finite elements)".to_string(),
-                    };
-                    self.sink.push(
-                        Diagnostic::error(Code::E0211, format!("unknown solver `{other}`"))
-                            .at(m.span, "not a solver")
-                            .hint(hint),
-                    );
-                    return None;
-                }
-            };
-        }
-        let p = self.props(
-            &props,
-            &[
-                "alpha",
-                "dt",
-                "steps",
-                "until",
-                "every",
-                "start",
-                "tolerance",
-                "max_iterations",
-            ],
-            "a solve block",
-        );
-        let mut alpha = match p.get("alpha") {
-            Some(a) => self.scalar(&a.value, Dim::NONE, "`alpha`")?,
-            None => -0.1,
-        };
-        if let Some(a) = p.get("alpha") {
-            if !(-1.0 / 3.0 - 1e-12..=0.0).contains(&alpha) {
-                self.sink.push(Diagnostic::error(Code::E0213, format!("HHT alpha = {alpha} is outside [-1/3, 0]")).at(a.value.span, "out of range").hint("alpha = -0.1 is the usual choice; 0 adds no numerical dissipation, -1/3 the most"));
-                return None;
-            }
-        }
-        let mut dt = match p.get("dt") {
-            Some(d) => Some((self.scalar(&d.value, Dim::TIME, "`dt`")?, d.value.span)),
-            None => None,
-        };
-        let mut steps = match p.get("steps") {
-            Some(s) => Some(self.integer(&s.value, "`steps`", 1)?),
-            None => None,
-        };
-        let mut until = match p.get("until") {
-            Some(u) => Some((self.scalar(&u.value, Dim::TIME, "`until`")?, u.value.span)),
-            None => None,
-        };
-        let mut every = match p.get("every") {
-            Some(e) => self.integer(&e.value, "`every`", 1)?,
-            None => 1,
-        };
-        let mut start = match p.get("start") {
-            Some(s) => match &s.value.kind {
-                ExprKind::Path { path } if path.text() == "consistent" => Start::Consistent,
-                ExprKind::Path { path } if path.text() == "zero_acceleration" => {
-                    Start::ZeroAcceleration
-                }
-                _ => {
-                    self.sink.push(Diagnostic::error(Code::E0211, "unknown start").at(s.value.span, "not a start option").hint("`start = consistent` (default) or `start = zero_acceleration` (the paper's start)"));
-                    return None;
-                }
-            },
-            None => Start::Consistent,
-        };
-        let tolerance = match p.get("tolerance") {
-            Some(t) => self.scalar(&t.value, Dim::NONE, "`tolerance`")?,
-            None => 1e-10,
-        };
-        let max_iterations = match p.get("max_iterations") {
-            Some(m) => self.integer(&m.value, "`max_iterations`", 1)?,
-            None => 25,
-        };
-        for (name, value, s) in [("dt", dt, p.get("dt")), ("until", until, p.get("until"))] {
-            if let (Some((v, vs)), Some(_)) = (value, s) {
-                if v <= 0.0 {
-                    self.sink.push(
-                        Diagnostic::error(Code::E0213, format!("`{name}` must be positive"))
-                            .at(vs, "not positive")
-                            .hint("times are positive durations, e.g. `dt = 0.005 s`"),
-                    );
-                    return None;
-                }
-            }
-        }
-        if !(tolerance > 0.0 && tolerance < 1e-2) {
-            self.sink.push(
-                Diagnostic::error(Code::E0213, "`tolerance` must lie in (0, 0.01)")
-                    .at(
-                        p.get("tolerance").map(|t| t.value.span).unwrap_or(span),
-                        "out of range",
-                    )
-                    .hint("the default 1e-10 is right for most models"),
             );
-            return None;
         }
-        // Command-line flags override the block.
-        integrator = o.integrator.unwrap_or(integrator);
-        alpha = o.alpha.unwrap_or(alpha);
-        if let Some(d) = o.dt {
-            dt = Some((d, span));
-            steps = None;
-        }
-        if let Some(n) = o.steps {
-            steps = Some(n);
-            dt = None;
-        }
-        if let Some(u) = o.until {
-            until = Some((u, span));
-        }
-        every = o.every.unwrap_or(every);
-        start = o.start.unwrap_or(start);
-        let Some((until, _)) = until else {
-            self.missing(span, "until", "the solve block", "1 s");
-            return None;
-        };
-        let (dt, steps) = match (dt, steps) {
-            (_, Some(n)) => (until / n as f64, n),
-            (Some((d, _)), None) => {
-                // The last step is shortened by at most round-off: dt is rounded to fit `until`.
-                let n = (until / d - 1e-9).ceil().max(1.0) as usize;
-                (until / n as f64, n)
+        for (d, decl) in self.env.decls.iter().enumerate() {
+            if decl.used || decl.name_span.source != main {
+                continue;
             }
-            (None, None) => {
-                self.missing(span, "dt", "the solve block", "0.005 s");
-                return None;
+            if let Some(Built::Section(_)) = self.built[d] {
+                warnings.push(
+                    Diagnostic::error(
+                        Code::W0202,
+                        format!("section `{}` is never used", decl.name),
+                    )
+                    .at(decl.name_span, "declared here")
+                    .hint("remove it, or give it to a beam: `section = NAME`"),
+                );
             }
-        };
-        Some(SolveSpec {
-            integrator,
-            alpha,
-            dt,
-            steps,
-            until,
-            every,
-            start,
-            tolerance,
-            max_iterations,
-            span,
-        })
+        }
+        for (name, span) in &out.local_components {
+            let defined = self.env.scopes.iter().any(|s| {
+                s.names.get(name).map(|n| matches!(n, Named::Component(c, _) if c.name.span == *span && out.instantiated.contains(&c.span))).unwrap_or(false)
+            });
+            if !defined {
+                warnings.push(
+                    Diagnostic::error(
+                        Code::W0202,
+                        format!("component `{name}` is never instantiated"),
+                    )
+                    .at(*span, "declared here")
+                    .hint(format!(
+                        "remove it, or instantiate it: `NAME = {name}(...)`"
+                    )),
+                );
+            }
+        }
+        warnings.sort_by_key(|d| d.labels.first().map(|l| l.span.start));
+        for w in warnings {
+            self.sink.push(w);
+        }
     }
 }
 
-fn unit_hint(dim: Dim) -> String {
+pub(super) fn unit_hint(dim: Dim) -> String {
     let example = match (dim.mass, dim.length, dim.time) {
         (1, 0, 0) => "`1.0 kg`",
         (0, 1, 0) => "`0.5 m` or `(0, -0.5, 0) m`",
         (0, 0, 1) => "`0.005 s`",
         (0, 1, -1) => "`1.5 m/s` or `(1.5, 0, 0) m/s`",
         (0, 1, -2) => "`(0, -9.81, 0) m/s^2`",
+        (0, 0, -1) => "`98.17 rad/s`",
+        (1, 1, -2) => "`20 N` or `(20, 0, 0) N`",
+        (1, 2, -2) => "`14 N*m` (or `14 N*m/rad` for a torsional stiffness)",
+        (1, 0, -2) => "`15434 N/m`",
+        (1, 2, 0) => "`48.6 kg*m^2`",
         (0, 0, 0) => "a plain number",
         _ => "a value with units",
     };
     format!("expected a {}, e.g. {example}", dim.describe())
 }
 
-/// Where a marker is in the initial configuration.
-pub fn initial_position(m: &Marker, bodies: &[Body]) -> [f64; 3] {
-    match m.attach {
-        Attach::Ground(_) => m.offset,
-        Attach::Body(b) => bodies[b].position,
-    }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+pub(super) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-fn norm(a: [f64; 3]) -> f64 {
-    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+pub(super) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+pub(super) fn scale(a: [f64; 3], s: f64) -> [f64; 3] {
+    a.map(|x| x * s)
+}
+
+pub(super) fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+pub(super) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(super) fn norm(a: [f64; 3]) -> f64 {
+    dot(a, a).sqrt()
 }

@@ -4,18 +4,51 @@
 //! dimensions and topology, and fixes the order of the unknowns (each multiplier after the
 //! unknowns it couples). Reports every error it finds. Must not know integrators or faer.
 
+mod beams;
+mod bodies;
 mod build;
+mod connect;
 pub mod dofs;
+mod elaborate;
+mod env;
 pub mod eval;
-mod params;
+mod outputs;
+mod settings;
+pub mod topology;
+mod types;
 pub mod units;
 
 pub use build::build;
 pub use dofs::DofMap;
 pub use eval::Value;
 
+use crate::runtime::timefn::TimeFn;
 use crate::source::Span;
 use serde::Serialize;
+
+/// A request to load a module the model `use`s (the standard library is built in).
+pub enum LoadRequest<'a> {
+    /// `use mylib::tower` -> segments `["mylib", "tower"]`.
+    Module { path: &'a [String], from: &'a str },
+    /// `use "parts/tower.mbd"`.
+    File { path: &'a str, from: &'a str },
+}
+
+/// Finds the text of modules outside the standard library. The compiler does no file IO:
+/// the command line supplies a loader that reads files (next to the model, then MBD_PATH).
+pub trait Loader {
+    /// `Ok((display name, text))`; `Err(None)` if not found; `Err(Some(reason))` if unreadable.
+    fn load(&self, request: &LoadRequest) -> Result<(String, String), Option<String>>;
+}
+
+/// A loader that knows only the built-in standard library.
+pub struct NoFiles;
+
+impl Loader for NoFiles {
+    fn load(&self, _: &LoadRequest) -> Result<(String, String), Option<String>> {
+        Err(None)
+    }
+}
 
 /// Command-line overrides of params and of the `solve` block.
 #[derive(Clone, Debug, Default)]
@@ -31,6 +64,10 @@ pub struct Overrides {
     pub start: Option<Start>,
 }
 
+pub type Mat3 = [[f64; 3]; 3];
+
+pub const IDENTITY: Mat3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
 #[derive(Clone, Debug, Serialize)]
 pub struct Model {
     pub name: String,
@@ -39,7 +76,10 @@ pub struct Model {
     pub gravity: [f64; 3],
     pub grounds: Vec<Ground>,
     pub bodies: Vec<Body>,
+    pub beams: Vec<Beam>,
     pub joints: Vec<Joint>,
+    pub springs: Vec<Spring>,
+    pub loads: Vec<Load>,
     pub outputs: Vec<OutputChannel>,
     pub solve: SolveSpec,
     pub dofs: DofMap,
@@ -51,43 +91,183 @@ pub struct Ground {
     pub span: Span,
 }
 
-/// A point mass: 3 translational unknowns.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BodyKind {
+    /// 3 translational unknowns.
+    PointMass,
+    /// 6 unknowns: translation of the reference point and rotation.
+    Rigid,
+}
+
+/// A body. Its frame is fixed in it; at t = 0 the frame is `orientation` (columns: body axes
+/// in inertial components) placed at `position`.
 #[derive(Clone, Debug, Serialize)]
 pub struct Body {
     pub name: String,
     pub span: Span,
+    pub kind: BodyKind,
     pub mass: f64,
+    /// Centre of mass, from the reference point, in the body frame.
+    pub center: [f64; 3],
+    /// Inertia tensor about the centre of mass, in the body frame.
+    pub inertia: Mat3,
+    /// Reference point at t = 0 (inertial).
     pub position: [f64; 3],
+    pub orientation: Mat3,
+    /// Velocity of the reference point and angular velocity at t = 0 (inertial).
     pub velocity: [f64; 3],
+    pub angular_velocity: [f64; 3],
+    /// Named markers: name, offset from the reference point and axes, in the body frame.
+    pub markers: Vec<(String, [f64; 3], Mat3)>,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(tag = "on", content = "index", rename_all = "snake_case")]
+/// Sectional properties of a beam, in the section frame (axis 1 along the beam).
+#[derive(Clone, Debug, Serialize)]
+pub struct Section {
+    pub name: String,
+    /// 6x6 stiffness: forces (1: axial, 2, 3: shear) and moments (4: torsion, 5, 6: bending).
+    pub stiffness: [[f64; 6]; 6],
+    pub mass_per_length: f64,
+    /// Centre of mass offset in the section plane (axes 2, 3).
+    pub mass_offset: [f64; 2],
+    /// Mass moments of inertia per length: polar (about 1), about 2, about 3.
+    pub inertia: [f64; 3],
+}
+
+/// An elastic beam: geometrically exact beam elements between equally spaced nodes.
+#[derive(Clone, Debug, Serialize)]
+pub struct Beam {
+    pub name: String,
+    pub span: Span,
+    pub section: Section,
+    pub elements: usize,
+    /// Nodes per element: 2, 3 or 4.
+    pub order: usize,
+    /// Node positions at t = 0.
+    pub nodes: Vec<[f64; 3]>,
+    /// Section frame at t = 0 (columns: axes 1, 2, 3), the same at every node.
+    pub frame: Mat3,
+    pub length: f64,
+    /// Velocity and angular velocity of each node at t = 0.
+    pub velocities: Vec<[f64; 3]>,
+    pub angular_velocities: Vec<[f64; 3]>,
+    /// Concentrated masses on nodes: node, mass, inertia (inertial frame at t = 0).
+    pub point_masses: Vec<(usize, f64, Mat3)>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(tag = "on", rename_all = "snake_case")]
 pub enum Attach {
-    Ground(usize),
-    Body(usize),
+    Ground {
+        ground: usize,
+    },
+    Body {
+        body: usize,
+    },
+    BeamNode {
+        beam: usize,
+        node: usize,
+    },
+    /// A point between nodes, at arc length `s` from the beam's start.
+    BeamPoint {
+        beam: usize,
+        s: f64,
+    },
 }
 
-/// A joint's attachment point, fixed on a ground or a body.
+/// A point with axes, fixed on a ground, a body or a beam.
 #[derive(Clone, Debug, Serialize)]
 pub struct Marker {
     pub attach: Attach,
-    /// Offset from the ground's origin (a point mass takes none).
+    /// Offset from the attachment's reference point, in its frame.
     pub offset: [f64; 3],
+    /// Marker axes in the attachment's frame.
+    pub axes: Mat3,
+    /// Where it is at t = 0, and its axes then (inertial).
+    pub position: [f64; 3],
+    pub world_axes: Mat3,
+    /// How it was written, for messages.
+    pub text: String,
     pub span: Span,
+}
+
+/// How a revolute or prismatic joint's free motion is driven.
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "drive", rename_all = "snake_case")]
+pub enum Drive {
+    Free,
+    /// Prescribed relative angle (or displacement), zero at t = 0.
+    Position {
+        f: TimeFn,
+    },
+    /// Prescribed relative rate.
+    Rate {
+        f: TimeFn,
+    },
 }
 
 #[derive(Clone, Debug, Serialize)]
 #[serde(tag = "kind", rename_all = "snake_case")]
 pub enum JointKind {
+    /// Relative rotation about `axis` only; the relative angle is an extra unknown.
+    Revolute {
+        axis: [f64; 3],
+        spring: f64,
+        damper: f64,
+        rest_angle: f64,
+        drive: Drive,
+        torque: Option<TimeFn>,
+    },
+    /// Relative translation along `axis` only.
+    Prismatic {
+        axis: [f64; 3],
+        spring: f64,
+        damper: f64,
+        drive: Drive,
+        force: Option<TimeFn>,
+    },
+    /// Rotation about and translation along `axis`.
+    Cylindrical { axis: [f64; 3] },
+    /// Rotation about `axis_a` (fixed in the first body) and `axis_b` (in the second).
+    Universal { axis_a: [f64; 3], axis_b: [f64; 3] },
+    /// Coincident points, free rotation.
+    Spherical,
+    /// No relative motion.
+    Fixed,
     /// `|x_b - x_a| = length`: one multiplier, the link tension.
     Distance { length: f64 },
 }
 
 impl JointKind {
+    /// The number of constraint equations (multipliers).
     pub fn multipliers(&self) -> usize {
         match self {
+            JointKind::Revolute { drive, .. } | JointKind::Prismatic { drive, .. } => {
+                5 + usize::from(!matches!(drive, Drive::Free))
+            }
+            JointKind::Cylindrical { .. } => 4,
+            JointKind::Universal { .. } => 4,
+            JointKind::Spherical => 3,
+            JointKind::Fixed => 6,
             JointKind::Distance { .. } => 1,
+        }
+    }
+
+    /// Extra unknowns: the revolute joint's relative angle.
+    pub fn extra_unknowns(&self) -> usize {
+        usize::from(matches!(self, JointKind::Revolute { .. }))
+    }
+
+    pub fn name(&self) -> &'static str {
+        match self {
+            JointKind::Revolute { .. } => "revolute",
+            JointKind::Prismatic { .. } => "prismatic",
+            JointKind::Cylindrical { .. } => "cylindrical",
+            JointKind::Universal { .. } => "universal",
+            JointKind::Spherical => "spherical",
+            JointKind::Fixed => "fixed",
+            JointKind::Distance { .. } => "distance",
         }
     }
 }
@@ -102,10 +282,57 @@ pub struct Joint {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
+pub enum SpringKind {
+    /// Force along the line between the markers.
+    Linear,
+    /// Moment on the relative rotation of the markers' axes.
+    Torsional,
+}
+
+/// A spring and/or damper between two markers.
+#[derive(Clone, Debug, Serialize)]
+pub struct Spring {
+    pub name: String,
+    pub span: Span,
+    pub kind: SpringKind,
+    pub stiffness: f64,
+    pub damping: f64,
+    /// Free length (linear springs).
+    pub length: f64,
+    pub markers: [Marker; 2],
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum LoadKind {
+    Force,
+    Torque,
+}
+
+/// A force or torque applied at a marker, as a vector function of time.
+#[derive(Clone, Debug, Serialize)]
+pub struct Load {
+    pub name: String,
+    pub span: Span,
+    pub kind: LoadKind,
+    pub marker: Marker,
+    /// Components (inertial, or in the marker's axes if `follower`).
+    pub value: [TimeFn; 3],
+    pub follower: bool,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
 pub enum BodyQuantity {
     Position,
     Velocity,
     Acceleration,
+    AngularVelocity,
+    AngularAcceleration,
+    /// Direction cosines: component = 3 * row + column.
+    Rotation,
+    /// Conformal rotation vector relative to the initial orientation (principal state).
+    Crv,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -113,11 +340,24 @@ pub enum BodyQuantity {
 pub enum JointQuantity {
     /// The reaction force (for a distance joint: the tension, positive in traction).
     Force,
-    /// The constraint violation (for a distance joint: length error in metres).
+    /// The reaction moment.
+    Moment,
+    /// The relative angle (revolute) or displacement (prismatic), continuous.
+    Angle,
+    Rate,
+    /// The constraint violation.
     Violation,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum EnergyKind {
+    Kinetic,
+    Potential,
+    Total,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
 #[serde(tag = "of", rename_all = "snake_case")]
 pub enum Probe {
     Body {
@@ -125,9 +365,21 @@ pub enum Probe {
         quantity: BodyQuantity,
         component: usize,
     },
+    /// A point that is not a body's reference point: a marker or a beam node.
+    Point {
+        attach: Attach,
+        offset: [f64; 3],
+        quantity: BodyQuantity,
+        component: usize,
+    },
     Joint {
         joint: usize,
         quantity: JointQuantity,
+        /// The vector component, for force and moment of joints with several multipliers.
+        component: Option<usize>,
+    },
+    Energy {
+        kind: EnergyKind,
     },
 }
 

@@ -6,6 +6,7 @@
 
 mod assembly;
 mod elements;
+pub mod timefn;
 
 pub use assembly::{Assembler, Pattern};
 pub use elements::{Anchor, Element, Rate};

@@ -15,10 +15,51 @@ pub struct File {
     pub span: Span,
 }
 
+/// A declared name, optionally indexed: `blade[i]`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Name {
+    pub ident: Ident,
+    pub index: Option<Expr>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum PropValue {
+    Expr(Expr),
+    Block(Block),
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Prop {
     pub name: Ident,
-    pub value: Expr,
+    pub value: PropValue,
+}
+
+impl Prop {
+    pub fn span(&self) -> Span {
+        match &self.value {
+            PropValue::Expr(e) => self.name.span.to(e.span),
+            PropValue::Block(b) => self.name.span.to(b.span),
+        }
+    }
+}
+
+/// `marker NAME = position { axes = ... }` inside a body block.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct MarkerItem {
+    pub name: Name,
+    pub at: Option<Expr>,
+    pub block: Option<Block>,
+    pub span: Span,
+}
+
+/// `{ name = value, marker NAME = ..., ... }`
+#[derive(Clone, Debug, PartialEq, Serialize, Default)]
+pub struct Block {
+    pub props: Vec<Prop>,
+    pub markers: Vec<MarkerItem>,
+    pub span: Span,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -29,27 +70,91 @@ pub struct MarkerRef {
     pub span: Span,
 }
 
+/// One segment of a reference path: `blade[2]`, `root`, `at(1.5 m)`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Segment {
+    pub name: Ident,
+    pub index: Option<Box<Expr>>,
+    pub arg: Option<Box<Expr>>,
+    pub span: Span,
+}
+
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Path {
-    pub segments: Vec<Ident>,
+    pub segments: Vec<Segment>,
     pub span: Span,
 }
 
 impl Path {
+    /// The path as written, with index and argument expressions shown as `[..]` and `(..)`.
     pub fn text(&self) -> String {
         self.segments
             .iter()
-            .map(|s| s.name.as_str())
+            .map(|s| {
+                let mut t = s.name.name.clone();
+                if s.index.is_some() {
+                    t.push_str("[..]");
+                }
+                if s.arg.is_some() {
+                    t.push_str("(..)");
+                }
+                t
+            })
             .collect::<Vec<_>>()
             .join(".")
+    }
+
+    /// The single plain name this path is, if it is one (`bob`, not `bob.position`).
+    pub fn single(&self) -> Option<&Ident> {
+        match self.segments.as_slice() {
+            [s] if s.index.is_none() && s.arg.is_none() => Some(&s.name),
+            _ => None,
+        }
     }
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct OutputItem {
-    pub name: Option<Ident>,
+    pub name: Option<Name>,
     pub path: Path,
     pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CompParam {
+    pub name: Ident,
+    pub ty: Ident,
+    pub default: Option<Expr>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Component {
+    pub name: Ident,
+    pub params: Vec<CompParam>,
+    pub items: Vec<Item>,
+    pub span: Span,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Arg {
+    pub name: Ident,
+    pub value: Expr,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ExportItem {
+    pub name: Ident,
+    pub target: Option<Path>,
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", content = "value", rename_all = "snake_case")]
+pub enum UseTarget {
+    /// `use stdlib::rotor::lag_hinged_rotor`
+    Module(Vec<Ident>),
+    /// `use "parts/tower.mbd"`
+    File(String),
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -60,7 +165,21 @@ pub enum Item {
         title: Option<String>,
         span: Span,
     },
+    Use {
+        target: UseTarget,
+        span: Span,
+    },
     Param {
+        name: Ident,
+        value: Expr,
+        span: Span,
+    },
+    Let {
+        name: Ident,
+        value: Expr,
+        span: Span,
+    },
+    Function {
         name: Ident,
         value: Expr,
         span: Span,
@@ -69,20 +188,11 @@ pub enum Item {
         value: Expr,
         span: Span,
     },
-    Ground {
-        name: Ident,
-        span: Span,
-    },
-    PointMass {
-        name: Ident,
-        props: Vec<Prop>,
-        span: Span,
-    },
     Joint {
-        name: Ident,
+        name: Name,
         kind: Ident,
         markers: Vec<MarkerRef>,
-        props: Vec<Prop>,
+        block: Block,
         span: Span,
     },
     Output {
@@ -92,7 +202,45 @@ pub enum Item {
     Solve {
         method: Ident,
         args: Vec<Prop>,
-        props: Vec<Prop>,
+        block: Block,
+        span: Span,
+    },
+    Component(std::rc::Rc<Component>),
+    For {
+        var: Ident,
+        from: Expr,
+        to: Expr,
+        inclusive: bool,
+        items: Vec<Item>,
+        span: Span,
+    },
+    Export {
+        items: Vec<ExportItem>,
+        span: Span,
+    },
+    Instance {
+        name: Name,
+        component: Ident,
+        args: Vec<Arg>,
+        span: Span,
+    },
+    Initial {
+        what: Ident,
+        target: Path,
+        value: Expr,
+        about: Option<Expr>,
+        through: Option<Expr>,
+        span: Span,
+    },
+    /// `KIND NAME flags (markers) on MARKER = value { block }`
+    Entity {
+        kind: Ident,
+        name: Name,
+        flags: Vec<Ident>,
+        markers: Vec<MarkerRef>,
+        on: Option<MarkerRef>,
+        value: Option<Expr>,
+        block: Option<Block>,
         span: Span,
     },
 }
@@ -100,14 +248,21 @@ pub enum Item {
 impl Item {
     pub fn span(&self) -> Span {
         match self {
+            Item::Component(c) => c.span,
             Item::Model { span, .. }
+            | Item::Use { span, .. }
             | Item::Param { span, .. }
+            | Item::Let { span, .. }
+            | Item::Function { span, .. }
             | Item::Gravity { span, .. }
-            | Item::Ground { span, .. }
-            | Item::PointMass { span, .. }
             | Item::Joint { span, .. }
             | Item::Output { span, .. }
-            | Item::Solve { span, .. } => *span,
+            | Item::Solve { span, .. }
+            | Item::For { span, .. }
+            | Item::Export { span, .. }
+            | Item::Instance { span, .. }
+            | Item::Initial { span, .. }
+            | Item::Entity { span, .. } => *span,
         }
     }
 }
@@ -174,5 +329,10 @@ pub enum ExprKind {
         op: BinOp,
         lhs: Box<Expr>,
         rhs: Box<Expr>,
+    },
+    /// `piecewise MODE { t0: v0, t1: v1, ... }`
+    Piecewise {
+        mode: Option<Ident>,
+        knots: Vec<(Expr, Expr)>,
     },
 }

@@ -32,11 +32,7 @@ pub fn parse_file(text: &str, source: SourceId) -> Result<File, Diagnostic> {
         .ok_or_else(|| Diagnostic::error(Code::E0101, "empty parse"))?;
     let cx = Cx { source };
     let span = cx.span(&file);
-    let items = file
-        .into_inner()
-        .filter(|p| p.as_rule() != Rule::EOI)
-        .map(|p| cx.item(p))
-        .collect::<Result<_, _>>()?;
+    let items = cx.items(file.into_inner())?;
     Ok(File { items, span })
 }
 
@@ -107,7 +103,7 @@ fn syntax_error(e: pest::error::Error<Rule>, source: SourceId) -> Diagnostic {
 
 fn syntax_hint(expected: &[&str]) -> String {
     if expected.contains(&"a declaration") || expected.iter().any(|e| e.starts_with("`model")) {
-        "a file is a list of declarations: model, param, gravity, ground, point_mass, joint, output, solve"
+        "a file is a list of declarations: model, use, param, let, function, gravity, bodies (`rigid NAME { ... }`), joints, components, `for` loops, output, solve"
             .to_string()
     } else if expected.contains(&"an expression") || expected.contains(&"a value") {
         "write a value here: a number with an optional unit (`0.5 m`), a param name, a vector `(x, y, z)` or a call".to_string()
@@ -157,6 +153,13 @@ impl Cx {
         }
     }
 
+    fn items(&self, pairs: Pairs<Rule>) -> Parsed<Vec<Item>> {
+        pairs
+            .filter(|p| p.as_rule() != Rule::EOI)
+            .map(|p| self.item(p))
+            .collect()
+    }
+
     fn item(&self, p: Pair<Rule>) -> Parsed<Item> {
         let span = self.span(&p);
         let rule = p.as_rule();
@@ -167,40 +170,46 @@ impl Cx {
                 let title = it.next().map(|s| s.into_inner().as_str().to_string());
                 Item::Model { name, title, span }
             }
-            Rule::param_decl => {
-                let name = self.ident(take(&mut it, "param name")?);
-                let value = self.expr(take(&mut it, "param value")?)?;
-                Item::Param { name, value, span }
+            Rule::use_decl => {
+                let q = take(&mut it, "use target")?;
+                let target = match q.as_rule() {
+                    Rule::string => UseTarget::File(q.into_inner().as_str().to_string()),
+                    _ => UseTarget::Module(q.into_inner().map(|i| self.ident(i)).collect()),
+                };
+                Item::Use { target, span }
+            }
+            Rule::param_decl | Rule::let_decl | Rule::function_decl => {
+                let name = self.ident(take(&mut it, "name")?);
+                let value = self.expr(take(&mut it, "value")?)?;
+                match rule {
+                    Rule::param_decl => Item::Param { name, value, span },
+                    Rule::let_decl => Item::Let { name, value, span },
+                    _ => Item::Function { name, value, span },
+                }
             }
             Rule::gravity_decl => Item::Gravity {
                 value: self.expr(take(&mut it, "gravity value")?)?,
                 span,
             },
-            Rule::ground_decl => Item::Ground {
-                name: self.ident(take(&mut it, "ground name")?),
-                span,
-            },
-            Rule::point_mass_decl => {
-                let name = self.ident(take(&mut it, "body name")?);
-                let props = self.props(take(&mut it, "property block")?.into_inner())?;
-                Item::PointMass { name, props, span }
-            }
             Rule::joint_decl => {
-                let name = self.ident(take(&mut it, "joint name")?);
+                let name = self.name(take(&mut it, "joint name")?)?;
                 let kind = self.ident(take(&mut it, "joint kind")?);
-                let mut markers = Vec::new();
-                let mut props = Vec::new();
-                for q in it {
-                    match q.as_rule() {
-                        Rule::marker => markers.push(self.marker(q)?),
-                        _ => props = self.props(q.into_inner())?,
-                    }
-                }
+                let markers = self.connection(take(&mut it, "joint markers")?)?;
+                let block = match it.next() {
+                    Some(b) => self.block(b)?,
+                    None => Block {
+                        span: Span {
+                            start: span.end,
+                            ..span
+                        },
+                        ..Block::default()
+                    },
+                };
                 Item::Joint {
                     name,
                     kind,
                     markers,
-                    props,
+                    block,
                     span,
                 }
             }
@@ -211,17 +220,164 @@ impl Cx {
             Rule::solve_decl => {
                 let method = self.ident(take(&mut it, "solver name")?);
                 let mut args = Vec::new();
-                let mut props = Vec::new();
+                let mut block = Block {
+                    span: Span {
+                        start: span.end,
+                        ..span
+                    },
+                    ..Block::default()
+                };
                 for q in it {
                     match q.as_rule() {
-                        Rule::solve_args => args = self.props(q.into_inner())?,
-                        _ => props = self.props(q.into_inner())?,
+                        Rule::solve_args => {
+                            args = q
+                                .into_inner()
+                                .map(|p| self.prop(p))
+                                .collect::<Parsed<_>>()?
+                        }
+                        _ => block = self.block(q)?,
                     }
                 }
                 Item::Solve {
                     method,
                     args,
-                    props,
+                    block,
+                    span,
+                }
+            }
+            Rule::component_decl => {
+                let name = self.ident(take(&mut it, "component name")?);
+                let mut params = Vec::new();
+                let mut items = Vec::new();
+                for q in it {
+                    match q.as_rule() {
+                        Rule::comp_param => {
+                            let pspan = self.span(&q);
+                            let mut jt = q.into_inner();
+                            let pname = self.ident(take(&mut jt, "parameter name")?);
+                            let ty = self.ident(take(&mut jt, "parameter type")?);
+                            let default = jt.next().map(|e| self.expr(e)).transpose()?;
+                            params.push(CompParam {
+                                name: pname,
+                                ty,
+                                default,
+                                span: pspan,
+                            });
+                        }
+                        _ => items = self.items(q.into_inner())?,
+                    }
+                }
+                Item::Component(std::rc::Rc::new(Component {
+                    name,
+                    params,
+                    items,
+                    span,
+                }))
+            }
+            Rule::for_decl => {
+                let var = self.ident(take(&mut it, "loop variable")?);
+                let from = self.expr(take(&mut it, "range start")?)?;
+                let inclusive = take(&mut it, "range")?.as_str() == "..=";
+                let to = self.expr(take(&mut it, "range end")?)?;
+                let items = self.items(take(&mut it, "loop body")?.into_inner())?;
+                Item::For {
+                    var,
+                    from,
+                    to,
+                    inclusive,
+                    items,
+                    span,
+                }
+            }
+            Rule::export_decl => {
+                let mut items = Vec::new();
+                for q in it {
+                    let mut jt = q.into_inner();
+                    let name = self.ident(take(&mut jt, "export name")?);
+                    let target = jt.next().map(|p| self.path(p)).transpose()?;
+                    items.push(ExportItem { name, target });
+                }
+                Item::Export { items, span }
+            }
+            Rule::instance_decl => {
+                let name = self.name(take(&mut it, "instance name")?)?;
+                let component = self.ident(take(&mut it, "component name")?);
+                let args = it
+                    .map(|q| {
+                        let mut jt = q.into_inner();
+                        let name = self.ident(take(&mut jt, "argument name")?);
+                        let value = self.expr(take(&mut jt, "argument value")?)?;
+                        Ok(Arg { name, value })
+                    })
+                    .collect::<Parsed<_>>()?;
+                Item::Instance {
+                    name,
+                    component,
+                    args,
+                    span,
+                }
+            }
+            Rule::initial_decl => {
+                let what = self.ident(take(&mut it, "initial motion kind")?);
+                let mut target = None;
+                let mut value = None;
+                let mut about = None;
+                let mut through = None;
+                let mut last = Rule::initial_decl;
+                for q in it {
+                    match q.as_rule() {
+                        Rule::kw_of | Rule::kw_about | Rule::kw_through => last = q.as_rule(),
+                        Rule::path => target = Some(self.path(q)?),
+                        _ => {
+                            let e = self.expr(q)?;
+                            match last {
+                                Rule::kw_about => about = Some(e),
+                                Rule::kw_through => through = Some(e),
+                                _ => value = Some(e),
+                            }
+                        }
+                    }
+                }
+                Item::Initial {
+                    what,
+                    target: target.ok_or_else(|| internal("initial target").at(span, "here"))?,
+                    value: value.ok_or_else(|| internal("initial value").at(span, "here"))?,
+                    about,
+                    through,
+                    span,
+                }
+            }
+            Rule::entity_decl => {
+                let kind = self.ident(take(&mut it, "declaration kind")?);
+                let name = self.name(take(&mut it, "declaration name")?)?;
+                let mut flags = Vec::new();
+                let mut markers = Vec::new();
+                let mut on = None;
+                let mut value = None;
+                let mut block = None;
+                for q in it {
+                    match q.as_rule() {
+                        Rule::flag => flags.push(self.ident(q)),
+                        Rule::connection => markers = self.connection(q)?,
+                        Rule::on_clause => {
+                            let m = q
+                                .into_inner()
+                                .find(|r| r.as_rule() == Rule::marker)
+                                .ok_or_else(|| internal("marker").at(span, "here"))?;
+                            on = Some(self.marker(m)?)
+                        }
+                        Rule::block => block = Some(self.block(q)?),
+                        _ => value = Some(self.expr(q)?),
+                    }
+                }
+                Item::Entity {
+                    kind,
+                    name,
+                    flags,
+                    markers,
+                    on,
+                    value,
+                    block,
                     span,
                 }
             }
@@ -229,29 +385,98 @@ impl Cx {
         })
     }
 
-    fn props(&self, pairs: Pairs<Rule>) -> Parsed<Vec<Prop>> {
-        pairs
-            .map(|p| {
-                let mut it = p.into_inner();
-                let name = self.ident(take(&mut it, "property name")?);
-                let value = self.expr(take(&mut it, "property value")?)?;
-                Ok(Prop { name, value })
-            })
-            .collect()
+    fn name(&self, p: Pair<Rule>) -> Parsed<Name> {
+        let span = self.span(&p);
+        let mut it = p.into_inner();
+        let ident = self.ident(take(&mut it, "name")?);
+        let index = match it.next() {
+            Some(i) => Some(self.expr(take(&mut i.into_inner(), "index")?)?),
+            None => None,
+        };
+        Ok(Name { ident, index, span })
     }
 
-    fn path(&self, p: Pair<Rule>) -> Path {
+    fn connection(&self, p: Pair<Rule>) -> Parsed<Vec<MarkerRef>> {
+        p.into_inner().map(|m| self.marker(m)).collect()
+    }
+
+    fn block(&self, p: Pair<Rule>) -> Parsed<Block> {
         let span = self.span(&p);
-        Path {
-            segments: p.into_inner().map(|s| self.ident(s)).collect(),
+        let mut block = Block {
             span,
+            ..Block::default()
+        };
+        for q in p.into_inner() {
+            match q.as_rule() {
+                Rule::marker_item => {
+                    let mspan = self.span(&q);
+                    let mut name = None;
+                    let mut at = None;
+                    let mut inner = None;
+                    for r in q.into_inner() {
+                        match r.as_rule() {
+                            Rule::kw_marker => {}
+                            Rule::name => name = Some(self.name(r)?),
+                            Rule::block => inner = Some(self.block(r)?),
+                            _ => at = Some(self.expr(r)?),
+                        }
+                    }
+                    block.markers.push(MarkerItem {
+                        name: name.ok_or_else(|| internal("marker name").at(mspan, "here"))?,
+                        at,
+                        block: inner,
+                        span: mspan,
+                    });
+                }
+                _ => block.props.push(self.prop(q)?),
+            }
         }
+        Ok(block)
+    }
+
+    fn prop(&self, p: Pair<Rule>) -> Parsed<Prop> {
+        let mut it = p.into_inner();
+        let name = self.ident(take(&mut it, "property name")?);
+        let v = take(&mut it, "property value")?;
+        let value = match v.as_rule() {
+            Rule::block => PropValue::Block(self.block(v)?),
+            _ => PropValue::Expr(self.expr(v)?),
+        };
+        Ok(Prop { name, value })
+    }
+
+    fn path(&self, p: Pair<Rule>) -> Parsed<Path> {
+        let span = self.span(&p);
+        let mut segments = Vec::new();
+        for s in p.into_inner() {
+            let sspan = self.span(&s);
+            let mut it = s.into_inner();
+            let name = self.ident(take(&mut it, "path segment")?);
+            let mut index = None;
+            let mut arg = None;
+            if let Some(q) = it.next() {
+                let is_index = q.as_rule() == Rule::index;
+                let e = Box::new(self.expr(take(&mut q.into_inner(), "expression")?)?);
+                if is_index {
+                    index = Some(e);
+                } else {
+                    arg = Some(e);
+                }
+            }
+            segments.push(Segment {
+                name,
+                index,
+                arg,
+                span: sspan,
+            });
+        }
+        Ok(Path { segments, span })
     }
 
     fn marker(&self, p: Pair<Rule>) -> Parsed<MarkerRef> {
         let span = self.span(&p);
         let mut it = p.into_inner();
-        let path = self.path(take(&mut it, "marker path")?);
+        let path = self.path(take(&mut it, "marker path")?)?;
         let offset = it.next().map(|e| self.expr(e)).transpose()?;
         Ok(MarkerRef { path, offset, span })
     }
@@ -262,8 +487,8 @@ impl Cx {
         let mut path = None;
         for q in p.into_inner() {
             match q.as_rule() {
-                Rule::ident => name = Some(self.ident(q)),
-                _ => path = Some(self.path(q)),
+                Rule::name => name = Some(self.name(q)?),
+                _ => path = Some(self.path(q)?),
             }
         }
         let path = path.ok_or_else(|| internal("output path").at(span, "here"))?;
@@ -332,7 +557,25 @@ impl Cx {
                 let args = it.map(|e| self.expr(e)).collect::<Parsed<_>>()?;
                 ExprKind::Call { function, args }
             }
-            Rule::path => ExprKind::Path { path: self.path(p) },
+            Rule::path => ExprKind::Path {
+                path: self.path(p)?,
+            },
+            Rule::piecewise => {
+                let mut mode = None;
+                let mut knots = Vec::new();
+                for q in p.into_inner() {
+                    match q.as_rule() {
+                        Rule::ident => mode = Some(self.ident(q)),
+                        _ => {
+                            let mut it = q.into_inner();
+                            let t = self.expr(take(&mut it, "knot time")?)?;
+                            let v = self.expr(take(&mut it, "knot value")?)?;
+                            knots.push((t, v));
+                        }
+                    }
+                }
+                ExprKind::Piecewise { mode, knots }
+            }
             Rule::expr => self.expr(p)?.kind,
             _ => return Err(internal("a value").at(span, "here")),
         };

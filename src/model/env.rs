@@ -1,0 +1,878 @@
+//! Scopes, bindings and name resolution.
+//!
+//! A scope holds names: value bindings (params, lets, functions, component arguments, loop
+//! variables), declarations, indexed families of them (`blade[0..4]`), component instances and
+//! component definitions. Value bindings are evaluated lazily, in the scope that wrote them,
+//! so declaration order never matters; cycles are reported (E0207), not overflowed.
+//!
+//! Scopes are lexical: a component instance's scope has the scope that *defined* the component
+//! as its parent, while its arguments are evaluated in the caller's scope. A `for` body gets a
+//! scope of its own for the loop variable and its lets, but declares its bodies in the
+//! enclosing naming scope (its `home`), so `blade[i]` is visible after the loop.
+
+use super::eval::{eval, Names, Value};
+use super::types::ParamType;
+use super::units::Dim;
+use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::runtime::timefn::TimeFn;
+use crate::source::Span;
+use crate::syntax::ast::{Component, Expr, ExprKind, Ident, Item, Path, PropValue};
+use std::collections::{BTreeMap, HashMap};
+use std::rc::Rc;
+
+pub type ScopeId = usize;
+pub type DeclId = usize;
+pub type BindingId = usize;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Member {
+    Decl(DeclId),
+    Instance(ScopeId),
+}
+
+#[derive(Clone, Debug)]
+pub enum Named {
+    Binding(BindingId),
+    Decl(DeclId),
+    /// Indexed declarations or instances, by index.
+    Family(BTreeMap<i64, Member>),
+    Instance(ScopeId),
+    /// A component definition and the scope it was defined in.
+    Component(Rc<Component>, ScopeId),
+}
+
+pub struct Scope {
+    pub parent: Option<ScopeId>,
+    /// Prefix of the qualified names declared here: "" at top level, "rotor." in an instance.
+    pub prefix: String,
+    /// Where declarations made in this scope go (itself, or the enclosing one for a loop).
+    pub home: ScopeId,
+    pub names: HashMap<String, Named>,
+    /// First span of each name declared here, for "first declared here".
+    pub spans: HashMap<String, Span>,
+    /// Names visible from outside an instance; `None` exports everything.
+    pub exports: Option<HashMap<String, Option<Path>>>,
+    /// For an instance scope: the component's name and where it was instantiated.
+    pub instance: Option<(String, Span)>,
+    /// For an instance scope: the scope of the code that instantiated it.
+    pub caller: Option<ScopeId>,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BindingKind {
+    Param,
+    Let,
+    Function,
+    Arg,
+    LoopVar,
+}
+
+#[derive(Clone, Debug)]
+enum State {
+    Pending,
+    InProgress,
+    Done(Value),
+    Failed,
+}
+
+pub struct Binding {
+    pub name: String,
+    pub span: Span,
+    pub kind: BindingKind,
+    pub expr: Option<Expr>,
+    /// The scope `expr` is evaluated in.
+    pub scope: ScopeId,
+    /// A `--set` override (top-level params only).
+    pub set: Option<Expr>,
+    pub ty: Option<(ParamType, Span)>,
+    /// For a component argument: the component it belongs to (for messages).
+    pub component: Option<String>,
+    state: State,
+    pub used: bool,
+}
+
+/// A declaration: an entity or joint item, instantiated in a scope.
+pub struct Decl {
+    pub item: Rc<Item>,
+    /// The qualified name, e.g. `rotor.blade[2]`.
+    pub name: String,
+    /// The scope its expressions are evaluated in.
+    pub scope: ScopeId,
+    pub name_span: Span,
+    pub used: bool,
+}
+
+impl Decl {
+    /// The declaration's kind as written (`rigid`, `beam`, ...), or `joint`.
+    pub fn item_kind(&self) -> Option<&str> {
+        match &*self.item {
+            Item::Entity { kind, .. } => Some(kind.name.as_str()),
+            Item::Joint { .. } => Some("joint"),
+            _ => None,
+        }
+    }
+}
+
+/// One segment of a path with its index and argument evaluated.
+#[derive(Clone, Debug)]
+pub struct Seg {
+    pub name: Ident,
+    pub index: Option<(i64, Span)>,
+    pub arg: Option<(Value, Span)>,
+    pub span: Span,
+}
+
+/// What a path resolves to, before its trailing segments.
+#[derive(Clone, Debug)]
+pub enum Ref {
+    Binding(BindingId),
+    Decl(DeclId),
+    Instance(ScopeId),
+    Component(Rc<Component>),
+    /// `t`, `pi`, `x`, `y`, `z`.
+    Builtin(Value),
+}
+
+const BUILTINS: &[&str] = &["t", "pi", "x", "y", "z"];
+
+fn builtin(name: &str) -> Option<Value> {
+    let unit = |k: usize| {
+        let mut v = [0.0; 3];
+        v[k] = 1.0;
+        Value::Vector {
+            value: v,
+            dim: Dim::NONE,
+        }
+    };
+    Some(match name {
+        "t" => Value::Signal {
+            parts: vec![TimeFn::Time],
+            dim: Dim::TIME,
+        },
+        "pi" => Value::scalar(std::f64::consts::PI, Dim::NONE),
+        "x" => unit(0),
+        "y" => unit(1),
+        "z" => unit(2),
+        _ => return None,
+    })
+}
+
+#[derive(Default)]
+pub struct Env {
+    pub scopes: Vec<Scope>,
+    pub bindings: Vec<Binding>,
+    pub decls: Vec<Decl>,
+    /// Errors found while evaluating on demand.
+    pub errors: Vec<Diagnostic>,
+    /// Nesting of on-demand evaluations, to stop runaway self-reference.
+    depth: usize,
+}
+
+impl Env {
+    pub fn new_scope(
+        &mut self,
+        parent: Option<ScopeId>,
+        prefix: String,
+        home: Option<ScopeId>,
+    ) -> ScopeId {
+        let id = self.scopes.len();
+        self.scopes.push(Scope {
+            parent,
+            prefix,
+            home: home.unwrap_or(id),
+            names: HashMap::new(),
+            spans: HashMap::new(),
+            exports: None,
+            instance: None,
+            caller: None,
+        });
+        id
+    }
+
+    /// Declares `name` (optionally indexed) in the home of `scope`. Reports duplicates.
+    pub fn declare(
+        &mut self,
+        scope: ScopeId,
+        name: &Ident,
+        index: Option<i64>,
+        what: Named,
+    ) -> Result<(), Diagnostic> {
+        let home = self.scopes[scope].home;
+        let s = &mut self.scopes[home];
+        let first = s.spans.get(&name.name).copied();
+        let dup = |first: Option<Span>, label: String| {
+            let mut d = Diagnostic::error(Code::E0203, format!("`{label}` is declared twice"))
+                .at(name.span, "second declaration");
+            if let Some(f) = first {
+                d = d.at(f, "first declared here");
+            }
+            d.hint("every name in a scope must be distinct; inside a loop, index it: `blade[i]`")
+        };
+        match index {
+            None => {
+                if s.names.contains_key(&name.name) {
+                    return Err(dup(first, name.name.clone()));
+                }
+                s.names.insert(name.name.clone(), what);
+            }
+            Some(i) => {
+                let member = match what {
+                    Named::Decl(d) => Member::Decl(d),
+                    Named::Instance(sc) => Member::Instance(sc),
+                    _ => {
+                        return Err(Diagnostic::error(
+                            Code::E0214,
+                            "only declarations and instances can be indexed",
+                        )
+                        .at(name.span, "here")
+                        .hint("remove the index"))
+                    }
+                };
+                match s.names.get_mut(&name.name) {
+                    Some(Named::Family(map)) => {
+                        if map.contains_key(&i) {
+                            return Err(dup(first, format!("{}[{i}]", name.name)));
+                        }
+                        map.insert(i, member);
+                    }
+                    Some(_) => return Err(dup(first, name.name.clone())),
+                    None => {
+                        let mut map = BTreeMap::new();
+                        map.insert(i, member);
+                        s.names.insert(name.name.clone(), Named::Family(map));
+                    }
+                }
+            }
+        }
+        s.spans.entry(name.name.clone()).or_insert(name.span);
+        Ok(())
+    }
+
+    pub fn add_binding(&mut self, b: Binding) -> BindingId {
+        self.bindings.push(b);
+        self.bindings.len() - 1
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    pub fn binding(
+        name: &Ident,
+        span: Span,
+        kind: BindingKind,
+        expr: Option<Expr>,
+        scope: ScopeId,
+        ty: Option<(ParamType, Span)>,
+        value: Option<Value>,
+    ) -> Binding {
+        Binding {
+            name: name.name.clone(),
+            span,
+            kind,
+            expr,
+            scope,
+            set: None,
+            ty,
+            component: None,
+            state: match value {
+                Some(v) => State::Done(v),
+                None => State::Pending,
+            },
+            used: false,
+        }
+    }
+
+    /// Looks a plain name up through the scope chain.
+    pub fn lookup(&self, scope: ScopeId, name: &str) -> Option<Named> {
+        let mut s = Some(scope);
+        while let Some(id) = s {
+            if let Some(n) = self.scopes[id].names.get(name) {
+                return Some(n.clone());
+            }
+            s = self.scopes[id].parent;
+        }
+        None
+    }
+
+    /// Every name visible from `scope`, for "did you mean".
+    pub fn visible(&self, scope: ScopeId) -> Vec<String> {
+        let mut out: Vec<String> = BUILTINS.iter().map(|s| s.to_string()).collect();
+        let mut s = Some(scope);
+        while let Some(id) = s {
+            out.extend(self.scopes[id].names.keys().cloned());
+            s = self.scopes[id].parent;
+        }
+        out
+    }
+
+    /// The qualified name of a declaration made in `scope`.
+    pub fn qualified(&self, scope: ScopeId, name: &str, index: Option<i64>) -> String {
+        let prefix = &self.scopes[self.scopes[scope].home].prefix;
+        match index {
+            Some(i) => format!("{prefix}{name}[{i}]"),
+            None => format!("{prefix}{name}"),
+        }
+    }
+
+    /// "in this instance of component X" notes for a diagnostic raised in `scope`.
+    pub fn trace(&self, scope: ScopeId, mut d: Diagnostic) -> Diagnostic {
+        let mut s = Some(scope);
+        let mut n = 0;
+        while let Some(id) = s {
+            if let Some((comp, span)) = &self.scopes[id].instance {
+                if n < 4 {
+                    d = d.at(*span, format!("in this instance of component `{comp}`"));
+                }
+                n += 1;
+                s = self.scopes[id].caller;
+            } else {
+                s = self.scopes[id].parent;
+            }
+        }
+        d
+    }
+
+    pub fn eval_in(&mut self, scope: ScopeId, expr: &Expr) -> Result<Value, Diagnostic> {
+        let mut cx = Cx { env: self, scope };
+        eval(expr, &mut cx)
+    }
+
+    /// Evaluates an index or a count: a whole number.
+    pub fn integer_in(
+        &mut self,
+        scope: ScopeId,
+        expr: &Expr,
+        what: &str,
+    ) -> Result<i64, Diagnostic> {
+        match self.eval_in(scope, expr)? {
+            Value::Scalar { value, dim } if dim.is_none() && value.fract() == 0.0 && value.abs() < 1e9 => Ok(value as i64),
+            v => Err(Diagnostic::error(Code::E0214, format!("{what} must be a whole number"))
+                .at(expr.span, format!("this is {} {}", v.kind_name(), if v.dim().is_none() { String::new() } else { v.dim().describe() }))
+                .hint("indices and loop bounds are dimensionless integers, e.g. `blade[i]` with `for i in 0..N`")),
+        }
+    }
+
+    /// The value of a binding, evaluated on first use.
+    pub fn value_of(&mut self, id: BindingId, use_span: Span) -> Result<Value, Diagnostic> {
+        self.bindings[id].used = true;
+        match self.bindings[id].state.clone() {
+            State::Done(v) => return Ok(v),
+            State::Failed => return Err(secondary(use_span)),
+            State::InProgress => {
+                let b = &self.bindings[id];
+                self.errors.push(
+                    Diagnostic::error(
+                        Code::E0207,
+                        format!("`{}` is defined in terms of itself", b.name),
+                    )
+                    .at(b.span, "this definition depends on itself")
+                    .hint(
+                        "break the cycle: give one of these names a value that does not refer back",
+                    ),
+                );
+                self.bindings[id].state = State::Failed;
+                return Err(secondary(use_span));
+            }
+            State::Pending => {}
+        }
+        if let Some((ty, _)) = &self.bindings[id].ty {
+            if ty.is_reference() {
+                let b = &self.bindings[id];
+                return Err(Diagnostic::error(Code::E0222, format!("`{}` is a {}, not a value", b.name, ty.name()))
+                    .at(use_span, "used as a value here")
+                    .hint("markers and bodies go in joint and load declarations; use their properties (`body.mass`) in expressions"));
+            }
+        }
+        let Some(expr) = self.bindings[id].expr.clone() else {
+            self.bindings[id].state = State::Failed;
+            return Err(secondary(use_span));
+        };
+        self.bindings[id].state = State::InProgress;
+        let scope = self.bindings[id].scope;
+        let result = self
+            .eval_in(scope, &expr)
+            .and_then(|v| self.check_binding(id, v, &expr));
+        match result {
+            Ok(v) => {
+                self.bindings[id].state = State::Done(v.clone());
+                Ok(v)
+            }
+            Err(e) => {
+                if !is_secondary(&e) {
+                    let e = self.trace(scope, e);
+                    self.errors.push(e);
+                }
+                self.bindings[id].state = State::Failed;
+                Err(secondary(use_span))
+            }
+        }
+    }
+
+    /// Applies `--set` and the declared type to a freshly evaluated binding.
+    fn check_binding(&mut self, id: BindingId, v: Value, expr: &Expr) -> Result<Value, Diagnostic> {
+        let b = &self.bindings[id];
+        if b.kind == BindingKind::Param {
+            if let Value::Signal { .. } = v {
+                return Err(Diagnostic::error(
+                    Code::E0401,
+                    format!("param `{}` varies in time", b.name),
+                )
+                .at(expr.span, "depends on `t`")
+                .hint(format!(
+                    "params are constants; declare it as `function {} = ...`",
+                    b.name
+                )));
+            }
+            if let Some(set) = b.set.clone() {
+                let name = b.name.clone();
+                let scope = b.scope;
+                let given = self.eval_in(scope, &set)?;
+                return match given {
+                    // A bare number given with --set is read in SI units of the declared dimension.
+                    g if g.dim().is_none() && !v.dim().is_none() => Ok(g.with_dim(v.dim())),
+                    g if g.dim() == v.dim() && std::mem::discriminant(&g) == std::mem::discriminant(&v) => Ok(g),
+                    g => Err(Diagnostic::error(Code::E0202, format!("`--set {name}` has the wrong dimension"))
+                        .at(set.span, format!("this is a {}", g.dim().describe()))
+                        .hint(format!("`{name}` is a {}; give a plain number in SI units or a value with matching units", v.dim().describe()))),
+                };
+            }
+        }
+        if let Some((ty, tspan)) = b.ty {
+            if let Err(found) = ty.accepts(&v) {
+                let comp = b.component.clone().unwrap_or_default();
+                let name = b.name.clone();
+                return Err(Diagnostic::error(
+                    Code::E0215,
+                    format!("argument `{name}` of `{comp}` must be {}", ty.describe()),
+                )
+                .at(expr.span, format!("this is {found}"))
+                .at(tspan, "declared here")
+                .hint(ty.example()));
+            }
+            if let ParamType::Direction = ty {
+                if let Value::Vector { value, .. } = v {
+                    let n =
+                        (value[0] * value[0] + value[1] * value[1] + value[2] * value[2]).sqrt();
+                    return Ok(Value::Vector {
+                        value: value.map(|x| x / n),
+                        dim: Dim::NONE,
+                    });
+                }
+            }
+        }
+        Ok(v)
+    }
+
+    /// Evaluates the index and argument expressions of a path in `scope`.
+    pub fn segs(&mut self, scope: ScopeId, path: &Path) -> Result<Vec<Seg>, Diagnostic> {
+        let mut out = Vec::with_capacity(path.segments.len());
+        for s in &path.segments {
+            let index = match &s.index {
+                Some(e) => Some((self.integer_in(scope, e, "an index")?, e.span)),
+                None => None,
+            };
+            let arg = match &s.arg {
+                Some(e) => Some((self.eval_in(scope, e)?, e.span)),
+                None => None,
+            };
+            out.push(Seg {
+                name: s.name.clone(),
+                index,
+                arg,
+                span: s.span,
+            });
+        }
+        Ok(out)
+    }
+
+    /// Resolves a path to what it names, returning the segments left over (a property, a
+    /// marker, a quantity). Follows component arguments of reference type and export aliases.
+    pub fn resolve(
+        &mut self,
+        scope: ScopeId,
+        segs: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
+        self.depth += 1;
+        if self.depth > 64 {
+            self.depth -= 1;
+            return Err(
+                Diagnostic::error(Code::E0207, "this reference refers back to itself")
+                    .at(span, "resolving this never ends")
+                    .hint("an argument or export alias names itself, directly or through others"),
+            );
+        }
+        let r = self.resolve_inner(scope, segs, span);
+        self.depth -= 1;
+        r
+    }
+
+    fn resolve_inner(
+        &mut self,
+        scope: ScopeId,
+        segs: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
+        let Some(head) = segs.first() else {
+            return Err(Diagnostic::error(Code::E0201, "empty path").at(span, "here"));
+        };
+        let named = match self.lookup(scope, &head.name.name) {
+            Some(n) => n,
+            None => {
+                if let (Some(v), None) = (builtin(&head.name.name), head.index) {
+                    return Ok((Ref::Builtin(v), segs[1..].to_vec()));
+                }
+                let candidates = self.visible(scope);
+                let d =
+                    Diagnostic::error(Code::E0201, format!("unknown name `{}`", head.name.name))
+                        .at(head.name.span, "not declared");
+                return Err(match did_you_mean(&head.name.name, candidates.iter().map(|s| s.as_str())) {
+                    Some(s) => d.hint(format!("did you mean `{s}`?")),
+                    None => d.hint("declare it (`param`, `let`, a body, a joint, ...) or import it with `use`; names are case-sensitive"),
+                });
+            }
+        };
+        self.follow(named, head, &segs[1..], span)
+    }
+
+    /// Continues resolution from `named` (reached by segment `seg`) with the segments `rest`.
+    fn follow(
+        &mut self,
+        named: Named,
+        seg: &Seg,
+        rest: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
+        let name = &seg.name.name;
+        let not_indexed = |what: &str| {
+            Diagnostic::error(
+                Code::E0214,
+                format!("`{name}` is {what}, not an indexed family"),
+            )
+            .at(
+                seg.index.map(|i| i.1).unwrap_or(seg.span),
+                "index given here",
+            )
+            .hint(format!("write `{name}` without an index"))
+        };
+        let r = match named {
+            Named::Binding(b) => {
+                if seg.index.is_some() {
+                    return Err(not_indexed("a value"));
+                }
+                let is_ref = self.bindings[b]
+                    .ty
+                    .as_ref()
+                    .map(|t| t.0.is_reference())
+                    .unwrap_or(false);
+                if is_ref {
+                    // A marker or body argument: resolve what the caller wrote, in the caller's scope.
+                    self.bindings[b].used = true;
+                    let (expr, bscope) = (self.bindings[b].expr.clone(), self.bindings[b].scope);
+                    let Some(Expr {
+                        kind: ExprKind::Path { path },
+                        ..
+                    }) = expr
+                    else {
+                        return Err(secondary(span));
+                    };
+                    let mut segs = self.segs(bscope, &path)?;
+                    segs.extend_from_slice(rest);
+                    return self.resolve(bscope, &segs, span);
+                }
+                Ref::Binding(b)
+            }
+            Named::Decl(d) => {
+                if seg.index.is_some() {
+                    return Err(not_indexed("a single declaration"));
+                }
+                self.decls[d].used = true;
+                Ref::Decl(d)
+            }
+            Named::Component(c, _) => Ref::Component(c),
+            Named::Instance(s) => {
+                if seg.index.is_some() {
+                    return Err(not_indexed("a single instance"));
+                }
+                return self.enter_instance(s, rest, span);
+            }
+            Named::Family(map) => {
+                let Some((i, ispan)) = seg.index else {
+                    let (lo, hi) = (
+                        map.keys().next().copied().unwrap_or(0),
+                        map.keys().last().copied().unwrap_or(0),
+                    );
+                    return Err(Diagnostic::error(
+                        Code::E0214,
+                        format!("`{name}` is an indexed family; say which one"),
+                    )
+                    .at(seg.span, "no index")
+                    .hint(format!("write `{name}[i]` with i in {lo}..={hi}")));
+                };
+                match map.get(&i) {
+                    Some(Member::Decl(d)) => {
+                        self.decls[*d].used = true;
+                        Ref::Decl(*d)
+                    }
+                    Some(Member::Instance(s)) => return self.enter_instance(*s, rest, span),
+                    None => {
+                        let keys: Vec<i64> = map.keys().copied().collect();
+                        let range = match (keys.first(), keys.last()) {
+                            (Some(a), Some(b)) if (b - a + 1) as usize == keys.len() => {
+                                format!("{a}..={b}")
+                            }
+                            _ => keys
+                                .iter()
+                                .map(|k| k.to_string())
+                                .collect::<Vec<_>>()
+                                .join(", "),
+                        };
+                        return Err(Diagnostic::error(
+                            Code::E0214,
+                            format!("index {i} is out of range for `{name}`"),
+                        )
+                        .at(ispan, "no such member")
+                        .hint(format!("`{name}` has indices {range}")));
+                    }
+                }
+            }
+        };
+        Ok((r, rest.to_vec()))
+    }
+
+    /// Resolves the segments after an instance name, honouring its exports.
+    fn enter_instance(
+        &mut self,
+        s: ScopeId,
+        rest: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
+        let Some(next) = rest.first() else {
+            return Ok((Ref::Instance(s), Vec::new()));
+        };
+        let key = next.name.name.clone();
+        if let Some(exports) = &self.scopes[s].exports {
+            match exports.get(&key) {
+                None => {
+                    let comp = self.scopes[s]
+                        .instance
+                        .clone()
+                        .map(|i| i.0)
+                        .unwrap_or_default();
+                    let mut names: Vec<&String> = exports.keys().collect();
+                    names.sort();
+                    let list = names
+                        .iter()
+                        .map(|n| n.as_str())
+                        .collect::<Vec<_>>()
+                        .join(", ");
+                    let code = if self.scopes[s].names.contains_key(&key) {
+                        Code::E0219
+                    } else {
+                        Code::E0201
+                    };
+                    let d = Diagnostic::error(
+                        code,
+                        format!("component `{comp}` does not export `{key}`"),
+                    )
+                    .at(next.name.span, "not exported");
+                    return Err(match did_you_mean(&key, names.iter().map(|n| n.as_str())) {
+                        Some(m) => d.hint(format!("did you mean `{m}`? It exports: {list}")),
+                        None => d.hint(format!("it exports: {list}")),
+                    });
+                }
+                Some(Some(alias)) => {
+                    let alias = alias.clone();
+                    let mut segs = self.segs(s, &alias)?;
+                    if let Some(i) = next.index {
+                        if let Some(last) = segs.last_mut() {
+                            if last.index.is_none() {
+                                last.index = Some(i);
+                            }
+                        }
+                    }
+                    segs.extend_from_slice(&rest[1..]);
+                    return self.resolve(s, &segs, span);
+                }
+                Some(None) => {}
+            }
+        }
+        match self.scopes[s].names.get(&key).cloned() {
+            Some(n) => self.follow(n, next, &rest[1..], span),
+            None => {
+                let comp = self.scopes[s]
+                    .instance
+                    .clone()
+                    .map(|i| i.0)
+                    .unwrap_or_default();
+                let names: Vec<String> = self.scopes[s].names.keys().cloned().collect();
+                let d =
+                    Diagnostic::error(Code::E0201, format!("component `{comp}` has no `{key}`"))
+                        .at(next.name.span, "not declared in the component");
+                Err(match did_you_mean(&key, names.iter().map(|n| n.as_str())) {
+                    Some(m) => d.hint(format!("did you mean `{m}`?")),
+                    None => d.hint(format!("it declares: {}", names.join(", "))),
+                })
+            }
+        }
+    }
+
+    /// The expression of property `prop` of a declaration, if written.
+    pub fn decl_prop(&self, d: DeclId, prop: &str) -> Option<Expr> {
+        match &*self.decls[d].item {
+            Item::Entity { block, value, .. } => {
+                if prop == "value" {
+                    if let Some(v) = value {
+                        return Some(v.clone());
+                    }
+                }
+                block
+                    .as_ref()?
+                    .props
+                    .iter()
+                    .find(|p| p.name.name == prop)
+                    .and_then(|p| match &p.value {
+                        PropValue::Expr(e) => Some(e.clone()),
+                        PropValue::Block(_) => None,
+                    })
+            }
+            Item::Joint { block, .. } => {
+                block
+                    .props
+                    .iter()
+                    .find(|p| p.name.name == prop)
+                    .and_then(|p| match &p.value {
+                        PropValue::Expr(e) => Some(e.clone()),
+                        PropValue::Block(_) => None,
+                    })
+            }
+            _ => None,
+        }
+    }
+}
+
+/// Evaluation context: an environment seen from one scope.
+pub struct Cx<'a> {
+    pub env: &'a mut Env,
+    pub scope: ScopeId,
+}
+
+fn component(v: Value, seg: &Seg) -> Result<Value, Diagnostic> {
+    let k = match seg.name.name.as_str() {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        other => {
+            return Err(
+                Diagnostic::error(Code::E0201, format!("a value has no `{other}`"))
+                    .at(seg.span, "not a component")
+                    .hint("take a vector component with `.x`, `.y` or `.z`"),
+            )
+        }
+    };
+    match v {
+        Value::Vector { value, dim } => Ok(Value::scalar(value[k], dim)),
+        Value::Signal { mut parts, dim } if parts.len() == 3 => Ok(Value::Signal {
+            parts: vec![parts.swap_remove(k)],
+            dim,
+        }),
+        other => Err(Diagnostic::error(
+            Code::E0209,
+            format!(
+                "`.{}` needs a vector, found {}",
+                seg.name.name,
+                other.kind_name()
+            ),
+        )
+        .at(seg.span, "not a vector")
+        .hint("components `.x`, `.y`, `.z` apply to vectors")),
+    }
+}
+
+impl Names for Cx<'_> {
+    fn path(&mut self, path: &Path) -> Result<Value, Diagnostic> {
+        let segs = self.env.segs(self.scope, path)?;
+        let (r, rest) = self.env.resolve(self.scope, &segs, path.span)?;
+        let (mut v, rest) = match r {
+            Ref::Builtin(v) => (v, rest),
+            Ref::Binding(b) => (self.env.value_of(b, path.span)?, rest),
+            Ref::Decl(d) => {
+                let Some(prop) = rest.first() else {
+                    let name = self.env.decls[d].name.clone();
+                    return Err(Diagnostic::error(
+                        Code::E0222,
+                        format!("`{name}` is a declaration, not a value"),
+                    )
+                    .at(path.span, "used as a value")
+                    .hint(format!("use one of its properties, e.g. `{name}.mass`")));
+                };
+                let Some(expr) = self.env.decl_prop(d, &prop.name.name) else {
+                    let name = self.env.decls[d].name.clone();
+                    return Err(Diagnostic::error(
+                        Code::E0201,
+                        format!("`{name}` does not set `{}`", prop.name.name),
+                    )
+                    .at(prop.span, "no such property written")
+                    .hint("expressions may use the properties a declaration writes in its block"));
+                };
+                let scope = self.env.decls[d].scope;
+                self.env.depth += 1;
+                let v = if self.env.depth > 64 {
+                    Err(Diagnostic::error(
+                        Code::E0207,
+                        "this property is defined in terms of itself",
+                    )
+                    .at(path.span, "here")
+                    .hint("break the cycle"))
+                } else {
+                    self.env.eval_in(scope, &expr)
+                };
+                self.env.depth -= 1;
+                (v?, rest[1..].to_vec())
+            }
+            Ref::Instance(s) => {
+                let comp = self.env.scopes[s]
+                    .instance
+                    .clone()
+                    .map(|i| i.0)
+                    .unwrap_or_default();
+                return Err(Diagnostic::error(
+                    Code::E0222,
+                    format!("an instance of `{comp}` is not a value"),
+                )
+                .at(path.span, "used as a value")
+                .hint("use one of its exported names"));
+            }
+            Ref::Component(c) => {
+                return Err(Diagnostic::error(
+                    Code::E0222,
+                    format!("`{}` is a component, not a value", c.name.name),
+                )
+                .at(path.span, "used as a value")
+                .hint(format!("instantiate it: `NAME = {}(...)`", c.name.name)));
+            }
+        };
+        for seg in &rest {
+            v = component(v, seg)?;
+        }
+        Ok(v)
+    }
+
+    fn function(&mut self, name: &Ident) -> Result<Option<Value>, Diagnostic> {
+        match self.env.lookup(self.scope, &name.name) {
+            Some(Named::Binding(b)) if self.env.bindings[b].kind == BindingKind::Function => {
+                Ok(Some(self.env.value_of(b, name.span)?))
+            }
+            _ => Ok(None),
+        }
+    }
+}
+
+/// Raised where a failure has been reported already.
+const SECONDARY: &str = "(reported already)";
+
+pub fn secondary(span: Span) -> Diagnostic {
+    Diagnostic::error(Code::E0201, SECONDARY).at(span, "")
+}
+
+pub fn is_secondary(d: &Diagnostic) -> bool {
+    d.message == SECONDARY
+}

@@ -1,0 +1,432 @@
+//! Output channels: `output x = bob.position.x, tension = link.force, rotor.lag[1].angle`.
+
+use super::build::{Builder, Built};
+use super::env::{Ref, ScopeId, Seg};
+use super::*;
+use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::syntax::ast::OutputItem;
+use std::collections::HashMap;
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+const CRV: [&str; 3] = ["c1", "c2", "c3"];
+const DCM: [&str; 9] = [
+    "r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33",
+];
+
+/// The quantities a point provides.
+const POINT_Q: &[&str] = &["position", "velocity", "acceleration"];
+const RIGID_Q: &[&str] = &[
+    "position",
+    "velocity",
+    "acceleration",
+    "angular_velocity",
+    "angular_acceleration",
+    "rotation",
+    "crv",
+];
+
+impl Builder<'_> {
+    pub(super) fn outputs(&mut self, items: &[(OutputItem, ScopeId)]) -> Vec<OutputChannel> {
+        let mut out: Vec<OutputChannel> = Vec::new();
+        let mut columns: HashMap<String, Span> = HashMap::new();
+        columns.insert("t".to_string(), Span::default());
+        for (item, scope) in items {
+            let scope = *scope;
+            let Some(probes) = self.probes(scope, item) else {
+                continue;
+            };
+            let base = match &item.name {
+                Some(n) => match &n.index {
+                    // `zeta[i] = ...` in a loop names columns zeta1, zeta2, ...
+                    Some(e) => match self.env.integer_in(scope, e, "an index") {
+                        Ok(i) => format!("{}{i}", n.ident.name),
+                        Err(d) => {
+                            self.error(scope, d);
+                            continue;
+                        }
+                    },
+                    None => n.ident.name.clone(),
+                },
+                None => item.path.text().replace("[..]", "").replace("(..)", ""),
+            };
+            let base = if item.name.is_none() {
+                self.written(scope, item).unwrap_or(base)
+            } else {
+                base
+            };
+            let n = probes.len();
+            for (suffix, probe) in probes {
+                let column = if n == 1 {
+                    base.clone()
+                } else {
+                    format!("{base}.{suffix}")
+                };
+                if let Some(first) = columns.get(&column) {
+                    let mut d = Diagnostic::error(
+                        Code::E0203,
+                        format!("output column `{column}` is declared twice"),
+                    )
+                    .at(item.span, "second column of that name");
+                    if first.end > 0 {
+                        d = d.at(*first, "first declared here");
+                    }
+                    self.error(scope, d.hint("name the output: `output NAME = PATH`"));
+                    continue;
+                }
+                columns.insert(column.clone(), item.span);
+                out.push(OutputChannel {
+                    column,
+                    probe,
+                    span: item.span,
+                });
+            }
+        }
+        out
+    }
+
+    /// The path as the column name: indices evaluated, `rotor.lag[1].angle`.
+    fn written(&mut self, scope: ScopeId, item: &OutputItem) -> Option<String> {
+        let segs = self.env.segs(scope, &item.path).ok()?;
+        Some(
+            segs.iter()
+                .map(|s| match s.index {
+                    Some((i, _)) => format!("{}[{i}]", s.name.name),
+                    None => s.name.name.clone(),
+                })
+                .collect::<Vec<_>>()
+                .join("."),
+        )
+    }
+
+    fn bad_quantity(
+        &mut self,
+        scope: ScopeId,
+        at: &Seg,
+        what: &str,
+        known: &[&str],
+    ) -> Option<Vec<(&'static str, Probe)>> {
+        let hint = match did_you_mean(&at.name.name, known.iter().copied()) {
+            Some(s) => format!("did you mean `{s}`? {what} provides: {}", known.join(", ")),
+            None => format!("{what} provides: {}", known.join(", ")),
+        };
+        self.error(
+            scope,
+            Diagnostic::error(
+                Code::E0212,
+                format!("`{}` is not an output quantity of {what}", at.name.name),
+            )
+            .at(at.span, "unknown quantity")
+            .hint(hint),
+        );
+        None
+    }
+
+    fn missing_quantity(
+        &mut self,
+        scope: ScopeId,
+        span: Span,
+        what: &str,
+        known: &[&str],
+    ) -> Option<Vec<(&'static str, Probe)>> {
+        self.error(
+            scope,
+            Diagnostic::error(
+                Code::E0212,
+                format!("say which quantity of {what} to output"),
+            )
+            .at(span, "no quantity")
+            .hint(format!("{what} provides: {}", known.join(", "))),
+        );
+        None
+    }
+
+    /// Splits a vector quantity into components, or selects one.
+    fn components(
+        &mut self,
+        scope: ScopeId,
+        rest: &[Seg],
+        names: &'static [&'static str],
+        make: impl Fn(usize) -> Probe,
+    ) -> Option<Vec<(&'static str, Probe)>> {
+        match rest {
+            [] => Some(
+                names
+                    .iter()
+                    .enumerate()
+                    .map(|(i, n)| (*n, make(i)))
+                    .collect(),
+            ),
+            [c] => match names.iter().position(|a| *a == c.name.name) {
+                Some(i) => Some(vec![("", make(i))]),
+                None => self.bad_quantity(scope, c, "this quantity", names),
+            },
+            [_, extra, ..] => self.bad_quantity(scope, extra, "a component", &[]),
+        }
+    }
+
+    fn point_quantity(
+        &mut self,
+        scope: ScopeId,
+        rest: &[Seg],
+        span: Span,
+        what: &str,
+        make: impl Fn(BodyQuantity, usize) -> Probe,
+    ) -> Option<Vec<(&'static str, Probe)>> {
+        let Some(q) = rest.first() else {
+            return self.missing_quantity(scope, span, what, POINT_Q);
+        };
+        let quantity = match q.name.name.as_str() {
+            "position" => BodyQuantity::Position,
+            "velocity" => BodyQuantity::Velocity,
+            "acceleration" => BodyQuantity::Acceleration,
+            _ => return self.bad_quantity(scope, q, what, POINT_Q),
+        };
+        self.components(scope, &rest[1..], &AXES, |i| make(quantity, i))
+    }
+
+    fn probes(&mut self, scope: ScopeId, item: &OutputItem) -> Option<Vec<(&'static str, Probe)>> {
+        let path = &item.path;
+        if let Some(single) = path.single() {
+            let energy = match single.name.as_str() {
+                "kinetic_energy" => Some(EnergyKind::Kinetic),
+                "potential_energy" => Some(EnergyKind::Potential),
+                "total_energy" => Some(EnergyKind::Total),
+                _ => None,
+            };
+            if let (Some(kind), None) = (energy, self.env.lookup(scope, &single.name)) {
+                return Some(vec![("", Probe::Energy { kind })]);
+            }
+        }
+        let segs = match self.env.segs(scope, path) {
+            Ok(s) => s,
+            Err(d) => {
+                self.error(scope, d);
+                return None;
+            }
+        };
+        let (r, rest) = match self.env.resolve(scope, &segs, path.span) {
+            Ok(x) => x,
+            Err(d) => {
+                self.error(scope, d);
+                return None;
+            }
+        };
+        let d = match r {
+            Ref::Decl(d) => d,
+            _ => {
+                self.error(
+                    scope,
+                    Diagnostic::error(Code::E0212, format!("`{}` is not something the model can output", path.text()))
+                        .at(path.span, "not a body, beam or joint")
+                        .hint("outputs name a body, a beam point or a joint quantity, e.g. `bob.position.x`, `link.force`, `rotor.lag[1].angle`, or `kinetic_energy`"),
+                );
+                return None;
+            }
+        };
+        let name = self.env.decls[d].name.clone();
+        match self.built[d]? {
+            Built::Body(b) => {
+                let body = self.bodies[b].clone();
+                // A named marker first: `bar.end.position`.
+                if let Some(m) = rest
+                    .first()
+                    .and_then(|s| body.markers.iter().find(|x| x.0 == s.name.name))
+                {
+                    let offset = m.1;
+                    return self.point_quantity(
+                        scope,
+                        &rest[1..],
+                        path.span,
+                        &format!("marker `{name}.{}`", m.0),
+                        |quantity, component| Probe::Point {
+                            attach: Attach::Body { body: b },
+                            offset,
+                            quantity,
+                            component,
+                        },
+                    );
+                }
+                let known = if body.kind == BodyKind::Rigid {
+                    RIGID_Q
+                } else {
+                    POINT_Q
+                };
+                let what = format!("body `{name}`");
+                let Some(q) = rest.first() else {
+                    return self.missing_quantity(scope, path.span, &what, known);
+                };
+                let quantity = match (q.name.name.as_str(), body.kind) {
+                    ("position", _) => BodyQuantity::Position,
+                    ("velocity", _) => BodyQuantity::Velocity,
+                    ("acceleration", _) => BodyQuantity::Acceleration,
+                    ("angular_velocity", BodyKind::Rigid) => BodyQuantity::AngularVelocity,
+                    ("angular_acceleration", BodyKind::Rigid) => BodyQuantity::AngularAcceleration,
+                    ("rotation", BodyKind::Rigid) => BodyQuantity::Rotation,
+                    ("crv", BodyKind::Rigid) => BodyQuantity::Crv,
+                    _ => {
+                        let mut all: Vec<&str> = known.to_vec();
+                        let markers: Vec<String> =
+                            body.markers.iter().map(|m| m.0.clone()).collect();
+                        all.extend(markers.iter().map(|s| s.as_str()));
+                        return self.bad_quantity(scope, q, &what, &all);
+                    }
+                };
+                let names: &'static [&'static str] = match quantity {
+                    BodyQuantity::Rotation => &DCM,
+                    BodyQuantity::Crv => &CRV,
+                    _ => &AXES,
+                };
+                self.components(scope, &rest[1..], names, |component| Probe::Body {
+                    body: b,
+                    quantity,
+                    component,
+                })
+            }
+            Built::Beam(bi) => {
+                let beam = self.beams[bi].clone();
+                let n = beam.nodes.len();
+                let what = format!("beam `{name}`");
+                let Some(p) = rest.first() else {
+                    return self.missing_quantity(
+                        scope,
+                        path.span,
+                        &what,
+                        &["start", "end", "node[k]", "at(s)"],
+                    );
+                };
+                let attach = match (p.name.name.as_str(), p.index, &p.arg) {
+                    ("start", None, None) => Attach::BeamNode { beam: bi, node: 0 },
+                    ("end", None, None) => Attach::BeamNode {
+                        beam: bi,
+                        node: n - 1,
+                    },
+                    ("node", Some((k, ks)), None) => {
+                        if k < 0 || k as usize >= n {
+                            self.error(
+                                scope,
+                                Diagnostic::error(
+                                    Code::E0214,
+                                    format!(
+                                        "node {k} is out of range: beam `{name}` has nodes 0..={}",
+                                        n - 1
+                                    ),
+                                )
+                                .at(ks, "no such node")
+                                .hint(format!(
+                                    "{} elements of {} nodes give {n} nodes",
+                                    beam.elements, beam.order
+                                )),
+                            );
+                            return None;
+                        }
+                        Attach::BeamNode {
+                            beam: bi,
+                            node: k as usize,
+                        }
+                    }
+                    ("at", None, Some((super::eval::Value::Scalar { value, .. }, _))) => {
+                        let k = value / beam.length * (n - 1) as f64;
+                        if (k - k.round()).abs() < 1e-9 && k >= -1e-9 && (k.round() as usize) < n {
+                            Attach::BeamNode {
+                                beam: bi,
+                                node: k.round() as usize,
+                            }
+                        } else {
+                            Attach::BeamPoint {
+                                beam: bi,
+                                s: *value,
+                            }
+                        }
+                    }
+                    _ => {
+                        return self.bad_quantity(
+                            scope,
+                            p,
+                            &what,
+                            &["start", "end", "node[k]", "at(s)"],
+                        )
+                    }
+                };
+                self.point_quantity(
+                    scope,
+                    &rest[1..],
+                    path.span,
+                    &format!("a point of beam `{name}`"),
+                    |quantity, component| Probe::Point {
+                        attach,
+                        offset: [0.0; 3],
+                        quantity,
+                        component,
+                    },
+                )
+            }
+            Built::Joint(j) => {
+                let kind = self.joints[j].kind.clone();
+                let what = format!("{} joint `{name}`", kind.name());
+                let known: &[&str] = match kind {
+                    JointKind::Distance { .. } => &["force", "violation"],
+                    JointKind::Revolute { .. } | JointKind::Prismatic { .. } => {
+                        &["angle", "rate", "force", "moment", "violation"]
+                    }
+                    _ => &["force", "moment", "violation"],
+                };
+                let Some(q) = rest.first() else {
+                    return self.missing_quantity(scope, path.span, &what, known);
+                };
+                if !known.contains(&q.name.name.as_str()) {
+                    return self.bad_quantity(scope, q, &what, known);
+                }
+                let quantity = match q.name.name.as_str() {
+                    "angle" => JointQuantity::Angle,
+                    "rate" => JointQuantity::Rate,
+                    "force" => JointQuantity::Force,
+                    "moment" => JointQuantity::Moment,
+                    _ => JointQuantity::Violation,
+                };
+                let scalar = matches!(
+                    quantity,
+                    JointQuantity::Angle | JointQuantity::Rate | JointQuantity::Violation
+                ) || matches!(kind, JointKind::Distance { .. });
+                if scalar {
+                    if let Some(extra) = rest.get(1) {
+                        return self.bad_quantity(scope, extra, "a scalar joint quantity", &[]);
+                    }
+                    return Some(vec![(
+                        "",
+                        Probe::Joint {
+                            joint: j,
+                            quantity,
+                            component: None,
+                        },
+                    )]);
+                }
+                self.components(scope, &rest[1..], &AXES, |c| Probe::Joint {
+                    joint: j,
+                    quantity,
+                    component: Some(c),
+                })
+            }
+            Built::Ground(_) => {
+                self.error(
+                    scope,
+                    Diagnostic::error(
+                        Code::E0212,
+                        format!("ground `{name}` has no output quantities"),
+                    )
+                    .at(path.span, "a ground does not move")
+                    .hint("output a body's position, velocity or acceleration, or a joint's force"),
+                );
+                None
+            }
+            _ => {
+                self.error(
+                    scope,
+                    Diagnostic::error(Code::E0212, format!("`{name}` has no output quantities"))
+                        .at(path.span, "not a body, beam or joint")
+                        .hint("output a body, a beam point or a joint quantity"),
+                );
+                None
+            }
+        }
+    }
+}

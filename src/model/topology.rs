@@ -1,0 +1,653 @@
+//! Topology checks at the initial configuration, before anything runs:
+//! - bodies with no path to ground (warning W0301, naming the free motions);
+//! - joints that lock rotations of a point mass, which has none (E0306);
+//! - redundant or contradictory constraints: the rank of the constraint Jacobian (E0307),
+//!   naming the joints whose equations are dependent;
+//! - motions with neither inertia nor restraint, which make the iteration matrix singular
+//!   (E0308), such as a massless body held by nothing.
+//!
+//! The Jacobian is taken with respect to virtual displacements and rotations of every node,
+//! which has the rank of the Jacobian in any rotation parameters.
+
+use super::build::{cross, dot, norm, sub};
+use super::dofs::{attach_nodes, Node};
+use super::*;
+use crate::diagnostics::{Code, Diagnostic, Sink};
+use nalgebra::{DMatrix, SymmetricEigen};
+
+/// Columns of a node in the virtual-motion vector.
+struct Columns {
+    start: Vec<usize>,
+    rotates: Vec<bool>,
+    n: usize,
+    nodes: Vec<Node>,
+}
+
+fn columns(model: &Model) -> Columns {
+    let mut nodes = Vec::new();
+    let mut start = Vec::new();
+    let mut rotates = Vec::new();
+    let mut n = 0;
+    for (body, b) in model.bodies.iter().enumerate() {
+        nodes.push(Node::Body { body });
+        start.push(n);
+        let r = b.kind == BodyKind::Rigid;
+        rotates.push(r);
+        n += if r { 6 } else { 3 };
+    }
+    for (beam, b) in model.beams.iter().enumerate() {
+        for node in 0..b.nodes.len() {
+            nodes.push(Node::BeamNode { beam, node });
+            start.push(n);
+            rotates.push(true);
+            n += 6;
+        }
+    }
+    Columns {
+        start,
+        rotates,
+        n,
+        nodes,
+    }
+}
+
+impl Columns {
+    fn of(&self, node: Node) -> usize {
+        self.nodes.iter().position(|x| *x == node).unwrap_or(0)
+    }
+}
+
+fn node_position(model: &Model, node: Node) -> [f64; 3] {
+    match node {
+        Node::Body { body } => model.bodies[body].position,
+        Node::BeamNode { beam, node } => model.beams[beam].nodes[node],
+    }
+}
+
+/// Rows of the linearised constraint equations, `dir . (relative translation)` or
+/// `dir . (relative rotation)`, scaled so rotations are measured in lengths of `scale`.
+struct Rows<'a> {
+    model: &'a Model,
+    cols: &'a Columns,
+    scale: f64,
+    rows: Vec<Vec<f64>>,
+}
+
+impl Rows<'_> {
+    /// Adds `sign * dir . (virtual displacement of the point p attached by a)`.
+    fn translation(&self, row: &mut [f64], a: &Attach, p: [f64; 3], dir: [f64; 3], sign: f64) {
+        let nodes = attach_nodes(self.model, a);
+        let w = 1.0 / nodes.len().max(1) as f64;
+        for node in nodes {
+            let k = self.cols.of(node);
+            let s = self.cols.start[k];
+            for i in 0..3 {
+                row[s + i] += sign * w * dir[i];
+            }
+            if self.cols.rotates[k] {
+                // d . (dtheta x r) = dtheta . (r x d)
+                let r = sub(p, node_position(self.model, node));
+                let c = cross(r, dir);
+                for i in 0..3 {
+                    row[s + 3 + i] += sign * w * c[i] / self.scale;
+                }
+            }
+        }
+    }
+
+    fn rotation(&self, row: &mut [f64], a: &Attach, dir: [f64; 3], sign: f64) {
+        let nodes = attach_nodes(self.model, a);
+        let w = 1.0 / nodes.len().max(1) as f64;
+        for node in nodes {
+            let k = self.cols.of(node);
+            if self.cols.rotates[k] {
+                let s = self.cols.start[k];
+                for i in 0..3 {
+                    row[s + 3 + i] += sign * w * dir[i];
+                }
+            }
+        }
+    }
+
+    fn lock_translation(&mut self, j: &Joint, dir: [f64; 3]) {
+        let mut row = vec![0.0; self.cols.n];
+        self.translation(
+            &mut row,
+            &j.markers[1].attach,
+            j.markers[1].position,
+            dir,
+            1.0,
+        );
+        self.translation(
+            &mut row,
+            &j.markers[0].attach,
+            j.markers[0].position,
+            dir,
+            -1.0,
+        );
+        self.rows.push(row);
+    }
+
+    fn lock_rotation(&mut self, j: &Joint, dir: [f64; 3]) {
+        let mut row = vec![0.0; self.cols.n];
+        self.rotation(&mut row, &j.markers[1].attach, dir, 1.0);
+        self.rotation(&mut row, &j.markers[0].attach, dir, -1.0);
+        self.rows.push(row);
+    }
+}
+
+/// Two unit vectors perpendicular to `n` and to each other.
+fn perpendiculars(n: [f64; 3]) -> ([f64; 3], [f64; 3]) {
+    let t = if n[0].abs() < 0.9 {
+        [1.0, 0.0, 0.0]
+    } else {
+        [0.0, 1.0, 0.0]
+    };
+    let a = cross(n, t);
+    let a = a.map(|x| x / norm(a));
+    (a, cross(n, a))
+}
+
+const E: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+
+/// The constraint rows of one joint, in the order of its multipliers.
+fn joint_rows(r: &mut Rows, j: &Joint) {
+    match &j.kind {
+        JointKind::Spherical => E.iter().for_each(|e| r.lock_translation(j, *e)),
+        JointKind::Fixed => {
+            E.iter().for_each(|e| r.lock_translation(j, *e));
+            E.iter().for_each(|e| r.lock_rotation(j, *e));
+        }
+        JointKind::Revolute { axis, drive, .. } => {
+            E.iter().for_each(|e| r.lock_translation(j, *e));
+            let (a, b) = perpendiculars(*axis);
+            r.lock_rotation(j, a);
+            r.lock_rotation(j, b);
+            if !matches!(drive, Drive::Free) {
+                r.lock_rotation(j, *axis);
+            }
+        }
+        JointKind::Prismatic { axis, drive, .. } => {
+            let (a, b) = perpendiculars(*axis);
+            r.lock_translation(j, a);
+            r.lock_translation(j, b);
+            E.iter().for_each(|e| r.lock_rotation(j, *e));
+            if !matches!(drive, Drive::Free) {
+                r.lock_translation(j, *axis);
+            }
+        }
+        JointKind::Cylindrical { axis } => {
+            let (a, b) = perpendiculars(*axis);
+            r.lock_translation(j, a);
+            r.lock_translation(j, b);
+            r.lock_rotation(j, a);
+            r.lock_rotation(j, b);
+        }
+        JointKind::Universal { axis_a, axis_b } => {
+            E.iter().for_each(|e| r.lock_translation(j, *e));
+            let c = cross(*axis_a, *axis_b);
+            r.lock_rotation(j, c.map(|x| x / norm(c)));
+        }
+        JointKind::Distance { .. } => {
+            let d = sub(j.markers[1].position, j.markers[0].position);
+            let n = norm(d);
+            r.lock_translation(j, d.map(|x| x / n));
+        }
+    }
+}
+
+fn locks_rotation(k: &JointKind) -> bool {
+    !matches!(k, JointKind::Spherical | JointKind::Distance { .. })
+}
+
+pub fn check(model: &Model, sink: &mut Sink) {
+    let cols = columns(model);
+    // A joint that locks rotations needs something that rotates on at least one side.
+    let mut bad = false;
+    for j in &model.joints {
+        if !locks_rotation(&j.kind) {
+            continue;
+        }
+        let rotating = j.markers.iter().any(|m| match m.attach {
+            Attach::Body { body } => model.bodies[body].kind == BodyKind::Rigid,
+            Attach::BeamNode { .. } | Attach::BeamPoint { .. } => true,
+            Attach::Ground { .. } => false,
+        });
+        let point_mass = j.markers.iter().any(|m| matches!(m.attach, Attach::Body { body } if model.bodies[body].kind == BodyKind::PointMass));
+        if !rotating || point_mass {
+            bad = true;
+            sink.push(
+                Diagnostic::error(Code::E0306, format!("{} joint `{}` locks rotations of a point mass", j.kind.name(), j.name))
+                    .at(j.span, "declared here")
+                    .hint("a point mass has no rotation: connect it with a `spherical` or `distance` joint, or make the body `rigid`"),
+            );
+        }
+    }
+    if bad {
+        return;
+    }
+    connectivity(model, sink);
+    let scale = length_scale(model);
+    let mut r = Rows {
+        model,
+        cols: &cols,
+        scale,
+        rows: Vec::new(),
+    };
+    let mut owner = Vec::new();
+    for (ji, j) in model.joints.iter().enumerate() {
+        let before = r.rows.len();
+        joint_rows(&mut r, j);
+        owner.extend(std::iter::repeat_n(ji, r.rows.len() - before));
+    }
+    let m = r.rows.len();
+    if m > 0 {
+        redundancy(model, &r.rows, &owner, cols.n, sink);
+    }
+    if sink.has_errors() {
+        return;
+    }
+    massless(model, &mut r, sink);
+}
+
+fn length_scale(model: &Model) -> f64 {
+    let mut s: f64 = 0.0;
+    for b in &model.bodies {
+        s = s.max(norm(b.position));
+        for m in &b.markers {
+            s = s.max(norm(m.1));
+        }
+    }
+    for b in &model.beams {
+        s = s.max(b.length);
+    }
+    if s > 0.0 {
+        s
+    } else {
+        1.0
+    }
+}
+
+/// Union-find over grounds (one node), bodies and beams.
+fn connectivity(model: &Model, sink: &mut Sink) {
+    let nb = model.bodies.len();
+    let n = nb + model.beams.len() + 1;
+    let ground = n - 1;
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn find(p: &mut [usize], x: usize) -> usize {
+        let mut r = x;
+        while p[r] != r {
+            r = p[r];
+        }
+        let mut y = x;
+        while p[y] != r {
+            let next = p[y];
+            p[y] = r;
+            y = next;
+        }
+        r
+    }
+    let id = |a: &Attach| match *a {
+        Attach::Ground { .. } => ground,
+        Attach::Body { body } => body,
+        Attach::BeamNode { beam, .. } | Attach::BeamPoint { beam, .. } => nb + beam,
+    };
+    let pairs = model
+        .joints
+        .iter()
+        .map(|j| (&j.markers[0], &j.markers[1]))
+        .chain(model.springs.iter().map(|s| (&s.markers[0], &s.markers[1])));
+    for (a, b) in pairs {
+        let (x, y) = (
+            find(&mut parent, id(&a.attach)),
+            find(&mut parent, id(&b.attach)),
+        );
+        parent[x] = y;
+    }
+    let g = find(&mut parent, ground);
+    let mut groups: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    for k in 0..n - 1 {
+        let r = find(&mut parent, k);
+        if r != g {
+            groups.entry(r).or_default().push(k);
+        }
+    }
+    for members in groups.values() {
+        let name = |k: usize| {
+            if k < nb {
+                model.bodies[k].name.clone()
+            } else {
+                model.beams[k - nb].name.clone()
+            }
+        };
+        let span = |k: usize| {
+            if k < nb {
+                model.bodies[k].span
+            } else {
+                model.beams[k - nb].span
+            }
+        };
+        let rotates = members
+            .iter()
+            .any(|&k| k >= nb || model.bodies[k].kind == BodyKind::Rigid);
+        let free = if rotates {
+            "translations along x, y, z and rotations about x, y, z"
+        } else {
+            "translations along x, y, z"
+        };
+        let others = match members.len() {
+            1 => String::new(),
+            2 => format!(" (with `{}`)", name(members[1])),
+            k => format!(" (with {} other bodies)", k - 1),
+        };
+        sink.push(
+            Diagnostic::error(Code::W0301, format!("`{}`{others} has no path to ground: its {free} are free", name(members[0])))
+                .at(span(members[0]), "floats freely")
+                .hint("connect it to a ground with a joint or a spring; a body meant to fly free (a free-flight test) may ignore this"),
+        );
+    }
+}
+
+fn redundancy(model: &Model, rows: &[Vec<f64>], owner: &[usize], n: usize, sink: &mut Sink) {
+    let m = rows.len();
+    let j = DMatrix::from_fn(m, n, |i, k| rows[i][k]);
+    let jjt = &j * j.transpose();
+    let eig = SymmetricEigen::new(jjt);
+    let top = eig.eigenvalues.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    let tol = 1e-10 * top.max(1e-30) * m as f64;
+    let null: Vec<usize> = (0..m)
+        .filter(|&i| eig.eigenvalues[i].abs() <= tol)
+        .collect();
+    if null.is_empty() {
+        return;
+    }
+    // The joints whose equations take part in a dependency.
+    let mut involved = vec![0.0f64; model.joints.len()];
+    for &c in &null {
+        for i in 0..m {
+            involved[owner[i]] = involved[owner[i]].max(eig.eigenvectors[(i, c)].abs());
+        }
+    }
+    let names: Vec<usize> = (0..model.joints.len())
+        .filter(|&k| involved[k] > 1e-6)
+        .collect();
+    let list = names
+        .iter()
+        .map(|&k| format!("`{}`", model.joints[k].name))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let mut d = Diagnostic::error(
+        Code::E0307,
+        format!(
+            "redundant constraints: {list} lock the same motion ({} equation{} too many)",
+            null.len(),
+            if null.len() == 1 { "" } else { "s" }
+        ),
+    );
+    for &k in &names {
+        d = d.at(
+            model.joints[k].span,
+            format!("{} joint", model.joints[k].kind.name()),
+        );
+    }
+    sink.push(d.hint(format!(
+        "the constraint Jacobian has rank {} for {m} equations at the initial configuration; free one of these joints (a spherical instead of a revolute, a cylindrical instead of a prismatic) or remove it",
+        m - null.len()
+    )));
+}
+
+/// Rows of inertia (the square root of each node's mass matrix) and of springs, stacked under
+/// the constraints: a null vector is a motion nothing resists.
+fn massless(model: &Model, r: &mut Rows, sink: &mut Sink) {
+    let cols = r.cols;
+    let n = cols.n;
+    if n == 0 || n > 3000 {
+        return;
+    }
+    let scale = r.scale;
+    for (body, b) in model.bodies.iter().enumerate() {
+        let s = cols.start[cols.of(Node::Body { body })];
+        let sm = b.mass.sqrt();
+        let c = super::eval::mat_vec(b.orientation, b.center);
+        for i in 0..3 {
+            // sqrt(m) (du + dtheta x c)_i
+            let mut row = vec![0.0; n];
+            row[s + i] = sm;
+            if b.kind == BodyKind::Rigid {
+                let e = E[i];
+                let rc = cross(c, e);
+                for k in 0..3 {
+                    row[s + 3 + k] = sm * rc[k] / scale;
+                }
+            }
+            r.rows.push(row);
+        }
+        if b.kind == BodyKind::Rigid {
+            let rot = super::eval::mat_mul(
+                super::eval::mat_mul(b.orientation, b.inertia),
+                super::eval::transpose(b.orientation),
+            );
+            let eig = SymmetricEigen::new(nalgebra::Matrix3::from_fn(|i, k| rot[i][k]));
+            for q in 0..3 {
+                let l = eig.eigenvalues[q].max(0.0).sqrt();
+                let mut row = vec![0.0; n];
+                for k in 0..3 {
+                    row[s + 3 + k] = l * eig.eigenvectors[(k, q)] / scale;
+                }
+                r.rows.push(row);
+            }
+        }
+    }
+    for (beam, b) in model.beams.iter().enumerate() {
+        for node in 0..b.nodes.len() {
+            let s = cols.start[cols.of(Node::BeamNode { beam, node })];
+            for i in 0..6 {
+                let mut row = vec![0.0; n];
+                row[s + i] = 1.0;
+                r.rows.push(row);
+            }
+        }
+    }
+    for sp in &model.springs {
+        if sp.stiffness <= 0.0 && sp.damping <= 0.0 {
+            continue;
+        }
+        match sp.kind {
+            SpringKind::Linear => {
+                let d = sub(sp.markers[1].position, sp.markers[0].position);
+                if norm(d) > 0.0 {
+                    let dir = d.map(|x| x / norm(d));
+                    let mut row = vec![0.0; n];
+                    r.translation(
+                        &mut row,
+                        &sp.markers[1].attach,
+                        sp.markers[1].position,
+                        dir,
+                        1.0,
+                    );
+                    r.translation(
+                        &mut row,
+                        &sp.markers[0].attach,
+                        sp.markers[0].position,
+                        dir,
+                        -1.0,
+                    );
+                    r.rows.push(row);
+                }
+            }
+            SpringKind::Torsional => {
+                for e in E {
+                    let mut row = vec![0.0; n];
+                    r.rotation(&mut row, &sp.markers[1].attach, e, 1.0);
+                    r.rotation(&mut row, &sp.markers[0].attach, e, -1.0);
+                    r.rows.push(row);
+                }
+            }
+        }
+    }
+    // Joint springs restrain the joint's free motion too.
+    for j in &model.joints {
+        match &j.kind {
+            JointKind::Revolute {
+                axis,
+                spring,
+                damper,
+                ..
+            } if *spring > 0.0 || *damper > 0.0 => r.lock_rotation(j, *axis),
+            JointKind::Prismatic {
+                axis,
+                spring,
+                damper,
+                ..
+            } if *spring > 0.0 || *damper > 0.0 => r.lock_translation(j, *axis),
+            _ => {}
+        }
+    }
+    let m = r.rows.len();
+    let a = DMatrix::from_fn(m, n, |i, k| r.rows[i][k]);
+    let ata = a.transpose() * &a;
+    let eig = SymmetricEigen::new(ata);
+    let top = eig.eigenvalues.iter().fold(0.0f64, |x, y| x.max(y.abs()));
+    let tol = 1e-12 * top.max(1e-30) * n as f64;
+    for c in 0..n {
+        if eig.eigenvalues[c].abs() > tol {
+            continue;
+        }
+        let v = eig.eigenvectors.column(c);
+        // The node that moves most in this motion, and how.
+        let (k, _) = (0..cols.nodes.len())
+            .map(|k| {
+                let s = cols.start[k];
+                let w = if cols.rotates[k] { 6 } else { 3 };
+                (k, (0..w).map(|i| v[s + i] * v[s + i]).sum::<f64>())
+            })
+            .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
+        let s = cols.start[k];
+        let t = [v[s], v[s + 1], v[s + 2]];
+        let rot = if cols.rotates[k] {
+            [v[s + 3], v[s + 4], v[s + 5]]
+        } else {
+            [0.0; 3]
+        };
+        let describe = |x: [f64; 3]| {
+            let n = norm(x);
+            format!("({:.3}, {:.3}, {:.3})", x[0] / n, x[1] / n, x[2] / n)
+        };
+        let motion = if norm(rot) >= norm(t) {
+            format!("rotation about {}", describe(rot))
+        } else {
+            format!("translation along {}", describe(t))
+        };
+        let (name, span) = match cols.nodes[k] {
+            Node::Body { body } => (model.bodies[body].name.clone(), model.bodies[body].span),
+            Node::BeamNode { beam, .. } => (model.beams[beam].name.clone(), model.beams[beam].span),
+        };
+        sink.push(
+            Diagnostic::error(Code::E0308, format!("`{name}` can move without inertia or restraint: {motion}"))
+                .at(span, "declared here")
+                .hint("give this motion mass or inertia, or hold it with a joint or a spring; otherwise the iteration matrix is singular"),
+        );
+        let _ = dot;
+        return;
+    }
+}
+
+/// The topology as `mbd check` prints it.
+pub fn report(model: &Model) -> String {
+    use std::fmt::Write;
+    let d = &model.dofs;
+    let mut s = String::new();
+    let nodes = model.bodies.len() + model.beams.iter().map(|b| b.nodes.len()).sum::<usize>();
+    let coords = d.len() - d.multipliers() - d.extras();
+    let _ = writeln!(s, "bodies:");
+    for b in &model.bodies {
+        let kind = match b.kind {
+            BodyKind::PointMass => "point mass, 3 DOFs",
+            BodyKind::Rigid => "rigid, 6 DOFs",
+        };
+        let _ = writeln!(s, "  {:<24} {kind}, mass {} kg", b.name, b.mass);
+    }
+    for b in &model.beams {
+        let _ = writeln!(
+            s,
+            "  {:<24} beam, {} elements of {} nodes, {} nodes, {} DOFs",
+            b.name,
+            b.elements,
+            b.order,
+            b.nodes.len(),
+            6 * b.nodes.len()
+        );
+    }
+    if !model.joints.is_empty() {
+        let _ = writeln!(s, "joints:");
+        for j in &model.joints {
+            let extra = if j.kind.extra_unknowns() > 0 {
+                " + angle"
+            } else {
+                ""
+            };
+            let _ = writeln!(
+                s,
+                "  {:<24} {} ({} -> {}), {} multipliers{extra}",
+                j.name,
+                j.kind.name(),
+                j.markers[0].text,
+                j.markers[1].text,
+                j.kind.multipliers()
+            );
+        }
+    }
+    if !model.springs.is_empty() || !model.loads.is_empty() {
+        let _ = writeln!(
+            s,
+            "springs and loads: {} springs/dampers, {} loads",
+            model.springs.len(),
+            model.loads.len()
+        );
+    }
+    let _ = writeln!(
+        s,
+        "unknowns: {} ({} nodes, {coords} DOFs, {} extra unknowns, {} multipliers), bandwidth {}",
+        d.len(),
+        nodes,
+        d.extras(),
+        d.multipliers(),
+        d.bandwidth
+    );
+    let _ = write!(s, "order:");
+    let mut line = String::new();
+    let mut k = 0;
+    while k < d.unknowns.len() {
+        let u = d.unknowns[k];
+        let (label, width) = match u {
+            dofs::Unknown::Translation { body, .. } => {
+                let w = if model.bodies[body].kind == BodyKind::Rigid {
+                    6
+                } else {
+                    3
+                };
+                (model.bodies[body].name.clone(), w)
+            }
+            dofs::Unknown::NodeTranslation { beam, node, .. } => {
+                (format!("{}.node[{node}]", model.beams[beam].name), 6)
+            }
+            dofs::Unknown::JointAngle { joint } => {
+                (format!("{}.angle", model.joints[joint].name), 1)
+            }
+            dofs::Unknown::Multiplier { joint, .. } => (
+                format!("λ {}", model.joints[joint].name),
+                model.joints[joint].kind.multipliers(),
+            ),
+            _ => (String::from("?"), 1),
+        };
+        let item = format!(" {label} [{k}..{}]", k + width - 1);
+        if line.len() + item.len() > 90 {
+            let _ = writeln!(s, "{line}");
+            line = String::from("      ");
+        }
+        line.push_str(&item);
+        k += width;
+    }
+    let _ = write!(s, "{line}");
+    s
+}

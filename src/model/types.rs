@@ -1,0 +1,196 @@
+//! The types of component parameters: `blades: int`, `hinge_offset: length`, `hub: marker`.
+
+use super::eval::Value;
+use super::units::Dim;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParamType {
+    Int,
+    /// A scalar of this dimension, constant or varying in time.
+    Scalar(Dim, &'static str),
+    /// A vector of this dimension.
+    Vector(Dim, &'static str),
+    /// A dimensionless non-zero vector, normalised.
+    Direction,
+    /// A scalar of any dimension, constant or varying in time.
+    Function,
+    /// A point on a body or ground, written as a path: `tower.tip`, `earth`.
+    Marker,
+    /// A body, written as a path.
+    Body,
+    /// A beam section, written as a path.
+    Section,
+}
+
+/// Every type name, its type, and an example for hints.
+pub const TYPES: &[(&str, ParamType, &str)] = &[
+    ("int", ParamType::Int, "4"),
+    ("real", ParamType::Scalar(Dim::NONE, "real"), "0.5"),
+    ("angle", ParamType::Scalar(Dim::NONE, "angle"), "30 deg"),
+    ("length", ParamType::Scalar(Dim::LENGTH, "length"), "0.3 m"),
+    ("mass", ParamType::Scalar(Dim::MASS, "mass"), "20 kg"),
+    ("time", ParamType::Scalar(Dim::TIME, "time"), "0.5 s"),
+    (
+        "velocity",
+        ParamType::Scalar(Dim::VELOCITY, "velocity"),
+        "1.5 m/s",
+    ),
+    (
+        "acceleration",
+        ParamType::Scalar(Dim::ACCELERATION, "acceleration"),
+        "9.81 m/s^2",
+    ),
+    (
+        "angular_velocity",
+        ParamType::Scalar(Dim::new(0, 0, -1), "angular_velocity"),
+        "98.17 rad/s",
+    ),
+    (
+        "frequency",
+        ParamType::Scalar(Dim::new(0, 0, -1), "frequency"),
+        "9.26 rad/s",
+    ),
+    ("force", ParamType::Scalar(Dim::FORCE, "force"), "20 N"),
+    (
+        "torque",
+        ParamType::Scalar(Dim::new(1, 2, -2), "torque"),
+        "2.5 kN*m",
+    ),
+    (
+        "stiffness",
+        ParamType::Scalar(Dim::new(1, 0, -2), "stiffness"),
+        "15434 N/m",
+    ),
+    (
+        "torsional_stiffness",
+        ParamType::Scalar(Dim::new(1, 2, -2), "torsional_stiffness"),
+        "14 N*m/rad",
+    ),
+    (
+        "damping",
+        ParamType::Scalar(Dim::new(1, 0, -1), "damping"),
+        "100 N*s/m",
+    ),
+    (
+        "torsional_damping",
+        ParamType::Scalar(Dim::new(1, 2, -1), "torsional_damping"),
+        "2 N*m*s/rad",
+    ),
+    (
+        "inertia",
+        ParamType::Scalar(Dim::new(1, 2, 0), "inertia"),
+        "48.6 kg*m^2",
+    ),
+    (
+        "mass_per_length",
+        ParamType::Scalar(Dim::new(1, -1, 0), "mass_per_length"),
+        "3.29 kg/m",
+    ),
+    (
+        "bending_stiffness",
+        ParamType::Scalar(Dim::new(1, 3, -2), "bending_stiffness"),
+        "1.28e4 N*m^2",
+    ),
+    (
+        "axial_stiffness",
+        ParamType::Scalar(Dim::FORCE, "axial_stiffness"),
+        "8.53e7 N",
+    ),
+    (
+        "pressure",
+        ParamType::Scalar(Dim::new(1, -1, -2), "pressure"),
+        "70 GPa",
+    ),
+    (
+        "position",
+        ParamType::Vector(Dim::LENGTH, "position"),
+        "(0, 0, 3.6) m",
+    ),
+    (
+        "vector",
+        ParamType::Vector(Dim::NONE, "vector"),
+        "(1, 0, 0)",
+    ),
+    ("direction", ParamType::Direction, "z or (0, 0, 1)"),
+    (
+        "function",
+        ParamType::Function,
+        "ramp(0 s, 0.5 s) * 2.5 kN*m",
+    ),
+    ("marker", ParamType::Marker, "tower.tip"),
+    ("body", ParamType::Body, "hub"),
+    ("section", ParamType::Section, "blade_section"),
+];
+
+impl ParamType {
+    pub fn parse(name: &str) -> Option<ParamType> {
+        TYPES.iter().find(|t| t.0 == name).map(|t| t.1)
+    }
+
+    pub fn name(&self) -> &'static str {
+        TYPES
+            .iter()
+            .find(|t| t.1 == *self)
+            .map(|t| t.0)
+            .unwrap_or("value")
+    }
+
+    /// Marker, body and section arguments are references, resolved where they are used.
+    pub fn is_reference(&self) -> bool {
+        matches!(
+            self,
+            ParamType::Marker | ParamType::Body | ParamType::Section
+        )
+    }
+
+    pub fn describe(&self) -> String {
+        match self {
+            ParamType::Int => "a whole number".to_string(),
+            ParamType::Scalar(d, n) => format!("a {n} ({})", d.describe()),
+            ParamType::Vector(d, n) => format!("a {n} vector ({})", d.describe()),
+            ParamType::Direction => "a direction (a non-zero dimensionless vector)".to_string(),
+            ParamType::Function => "a scalar or a function of time".to_string(),
+            ParamType::Marker => "a marker".to_string(),
+            ParamType::Body => "a body".to_string(),
+            ParamType::Section => "a section".to_string(),
+        }
+    }
+
+    pub fn example(&self) -> String {
+        let ex = TYPES
+            .iter()
+            .find(|t| t.1 == *self)
+            .map(|t| t.2)
+            .unwrap_or("...");
+        format!("give {}, e.g. `{ex}`", self.describe())
+    }
+
+    /// Checks a value against the type; `Err` describes what was found.
+    pub fn accepts(&self, v: &Value) -> Result<(), String> {
+        let found = || {
+            if v.dim().is_none() {
+                v.kind_name().to_string()
+            } else {
+                format!("{} of {}", v.kind_name(), v.dim().describe())
+            }
+        };
+        let ok = match (self, v) {
+            (ParamType::Int, Value::Scalar { value, dim }) => dim.is_none() && value.fract() == 0.0,
+            (ParamType::Scalar(d, _), Value::Scalar { dim, .. }) => d == dim,
+            (ParamType::Scalar(d, _), Value::Signal { parts, dim }) => parts.len() == 1 && d == dim,
+            (ParamType::Vector(d, _), Value::Vector { dim, .. }) => d == dim,
+            (ParamType::Vector(d, _), Value::Signal { parts, dim }) => parts.len() == 3 && d == dim,
+            (ParamType::Direction, Value::Vector { value, dim }) => {
+                dim.is_none() && value.iter().any(|x| *x != 0.0)
+            }
+            (ParamType::Function, Value::Scalar { .. }) => true,
+            (ParamType::Function, Value::Signal { parts, .. }) => parts.len() == 1,
+            _ => false,
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(found())
+        }
+    }
+}
