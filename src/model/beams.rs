@@ -285,6 +285,7 @@ impl Builder<'_> {
                 "e2",
                 "velocity",
                 "angular_velocity",
+                "spin_stretch",
             ],
             "a beam",
         );
@@ -345,8 +346,14 @@ impl Builder<'_> {
             None => Some(None),
         };
         let (velocity, angular_velocity) = self.motion(v, &p);
-        let (from, to, section, elements, order, twist, e2) =
-            (from?, to?, section?, elements?, order?, twist?, e2?);
+        let spin = match self.expr(v.scope, p.get("spin_stretch")) {
+            Some(e) => self
+                .scalar(v.scope, e, Dim::new(0, 0, -1), "`spin_stretch`")
+                .map(|w| Some((w, e.span))),
+            None => Some(None),
+        };
+        let (from, to, section, elements, order, twist, e2, spin) =
+            (from?, to?, section?, elements?, order?, twist?, e2?, spin?);
         let d = sub(to, from);
         let length = norm(d);
         if length == 0.0 {
@@ -395,7 +402,37 @@ impl Builder<'_> {
         let nodes: Vec<[f64; 3]> = (0..n)
             .map(|k| add(from, scale(d, k as f64 / (n - 1) as f64)))
             .collect();
-        let velocities = nodes
+        // The steady centrifugal stretch of a beam spinning about an axis through its start:
+        // u(s) = sin(b s) / (b cos(b L)) - s, b^2 = m Omega^2 / EA.
+        let mut initial_nodes = nodes.clone();
+        if let Some((w, wspan)) = spin {
+            let b = (section.mass_per_length * w * w / section.stiffness[0][0]).sqrt();
+            if (b * length).cos() <= 1e-6 {
+                self.error(
+                    v.scope,
+                    Diagnostic::error(
+                        Code::E0213,
+                        format!(
+                            "beam `{}` spins at or above its first axial resonance",
+                            v.name
+                        ),
+                    )
+                    .at(wspan, "no steady stretched state")
+                    .hint("check the spin rate, EA and the mass per length"),
+                );
+                return None;
+            }
+            for (k, x) in initial_nodes.iter_mut().enumerate() {
+                let s = length * k as f64 / (n - 1) as f64;
+                let u = if b > 0.0 {
+                    (b * s).sin() / (b * (b * length).cos()) - s
+                } else {
+                    0.0
+                };
+                *x = add(*x, scale(e1, u));
+            }
+        }
+        let velocities = initial_nodes
             .iter()
             .map(|x| add(velocity, cross(angular_velocity, sub(*x, from))))
             .collect();
@@ -418,6 +455,7 @@ impl Builder<'_> {
             angular_velocities: vec![angular_velocity; n],
             velocities,
             nodes,
+            initial_nodes,
             frame,
             length,
             point_masses: Vec::new(),

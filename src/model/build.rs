@@ -91,6 +91,7 @@ pub fn build(
         return None;
     }
     let mut el = Elaborator::new(sources, loader);
+    el.sets = overrides.sets.clone();
     let top = el.main(&file.items, file_name);
     let errors = std::mem::take(&mut el.errors);
     let out = std::mem::replace(
@@ -137,34 +138,6 @@ pub fn build(
         body_decl: Vec::new(),
         beam_decl: Vec::new(),
     };
-
-    // --set overrides name top-level params only.
-    for (name, expr) in &overrides.sets {
-        match b.env.scopes[top].names.get(&name.name) {
-            Some(Named::Binding(id)) if b.env.bindings[*id].kind == BindingKind::Param => {
-                b.env.bindings[*id].set = Some(expr.clone());
-            }
-            _ => {
-                let names = b.param_names(top);
-                let hint = match did_you_mean(&name.name, names.iter().map(|s| s.as_str())) {
-                    Some(s) => format!("did you mean `{s}`? Only params can be set"),
-                    None if names.is_empty() => "this model declares no params".to_string(),
-                    None => format!("the model's params are: {}", names.join(", ")),
-                };
-                b.sink.push(
-                    Diagnostic::error(
-                        Code::E0208,
-                        format!(
-                            "`--set {}`: the model has no param `{}`",
-                            name.name, name.name
-                        ),
-                    )
-                    .at(name.span, "unknown param")
-                    .hint(hint),
-                );
-            }
-        }
-    }
 
     // Params, in the order written.
     let mut params = Vec::new();
@@ -257,21 +230,6 @@ pub fn build(
 }
 
 impl Builder<'_> {
-    fn param_names(&self, top: ScopeId) -> Vec<String> {
-        let mut v: Vec<(u32, String)> = self.env.scopes[top]
-            .names
-            .iter()
-            .filter_map(|(k, n)| match n {
-                Named::Binding(id) if self.env.bindings[*id].kind == BindingKind::Param => {
-                    Some((self.env.bindings[*id].span.start, k.clone()))
-                }
-                _ => None,
-            })
-            .collect();
-        v.sort();
-        v.into_iter().map(|x| x.1).collect()
-    }
-
     fn view(&self, d: usize) -> Option<View> {
         let decl = &self.env.decls[d];
         match &*decl.item {

@@ -614,7 +614,10 @@ impl Builder<'_> {
             if inside(&self.env.decls[self.beam_decl[i]].name) {
                 let b = &mut self.beams[i];
                 for k in 0..b.nodes.len() {
-                    b.velocities[k] = add(b.velocities[k], add(v, cross(w, sub(b.nodes[k], p))));
+                    b.velocities[k] = add(
+                        b.velocities[k],
+                        add(v, cross(w, sub(b.initial_nodes[k], p))),
+                    );
                     b.angular_velocities[k] = add(b.angular_velocities[k], w);
                 }
                 moved += 1;

@@ -53,6 +53,9 @@ pub struct Elaborator<'a> {
     depth: usize,
     /// The file name of each source id (for relative `use`).
     file_names: Vec<String>,
+    /// `--set NAME=VALUE` overrides of top-level params, applied before any structure is built
+    /// (so they steer loops and conditions too).
+    pub sets: Vec<(Ident, crate::syntax::ast::Expr)>,
 }
 
 impl<'a> Elaborator<'a> {
@@ -75,6 +78,7 @@ impl<'a> Elaborator<'a> {
             loading: Vec::new(),
             depth: 0,
             file_names: Vec::new(),
+            sets: Vec::new(),
         }
     }
 
@@ -98,9 +102,70 @@ impl<'a> Elaborator<'a> {
         for item in items {
             self.declare_names(item, scope, at, file);
         }
+        if at == Where::Main {
+            self.apply_sets(scope);
+        }
         // Then structure.
         for item in items {
             self.structure(item, scope, at, file);
+        }
+    }
+
+    fn apply_sets(&mut self, top: ScopeId) {
+        for (name, expr) in std::mem::take(&mut self.sets) {
+            match self.env.scopes[top].names.get(&name.name) {
+                Some(Named::Binding(id)) if self.env.bindings[*id].kind == BindingKind::Param => {
+                    self.env.bindings[*id].set = Some(expr);
+                }
+                _ => {
+                    let mut names: Vec<(u32, String)> = self.env.scopes[top]
+                        .names
+                        .iter()
+                        .filter_map(|(k, n)| match n {
+                            Named::Binding(id)
+                                if self.env.bindings[*id].kind == BindingKind::Param =>
+                            {
+                                Some((self.env.bindings[*id].span.start, k.clone()))
+                            }
+                            _ => None,
+                        })
+                        .collect();
+                    names.sort();
+                    let names: Vec<String> = names.into_iter().map(|x| x.1).collect();
+                    let hint = match did_you_mean(&name.name, names.iter().map(|s| s.as_str())) {
+                        Some(s) => format!("did you mean `{s}`? Only params can be set"),
+                        None if names.is_empty() => "this model declares no params".to_string(),
+                        None => format!("the model's params are: {}", names.join(", ")),
+                    };
+                    self.errors.push(
+                        Diagnostic::error(
+                            Code::E0208,
+                            format!(
+                                "`--set {}`: the model has no param `{}`",
+                                name.name, name.name
+                            ),
+                        )
+                        .at(name.span, "unknown param")
+                        .hint(hint),
+                    );
+                }
+            }
+        }
+    }
+
+    /// Marks the names an untaken `if` branch mentions as used, so a param used only there is
+    /// not reported unused.
+    fn mention(&mut self, items: &[Item], scope: ScopeId) {
+        let Ok(text) = serde_json::to_string(items) else {
+            return;
+        };
+        for part in text.split("\"name\":\"").skip(1) {
+            let Some(name) = part.split('"').next() else {
+                continue;
+            };
+            if let Some(Named::Binding(id)) = self.env.lookup(scope, name) {
+                self.env.bindings[id].used = true;
+            }
         }
     }
 
@@ -226,7 +291,7 @@ impl<'a> Elaborator<'a> {
         }
         let b = Env::binding(name, span, kind, Some(value.clone()), scope, None, None);
         let id = self.env.add_binding(b);
-        if let Err(d) = self.env.declare(scope, name, None, Named::Binding(id)) {
+        if let Err(d) = self.env.declare_local(scope, name, id) {
             self.error(scope, d);
         }
     }
@@ -362,6 +427,33 @@ impl<'a> Elaborator<'a> {
                         .insert(var.name.clone(), Named::Binding(id));
                     self.items(items, inner, Where::Nested, file);
                 }
+            }
+            Item::If {
+                cond,
+                then,
+                otherwise,
+                span,
+            } => {
+                if at == Where::Module {
+                    return self.misplaced(scope, *span, "if", at);
+                }
+                let c = match self.env.eval_in(scope, cond) {
+                    Ok(super::eval::Value::Scalar { value, dim }) if dim.is_none() => value != 0.0,
+                    Ok(v) => {
+                        return self.error(
+                            scope,
+                            Diagnostic::error(Code::E0209, format!("a condition must be a constant number, found {}", v.kind_name()))
+                                .at(cond.span, "not a condition")
+                                .hint("write `if elastic { ... }` with a `bool` parameter, or any dimensionless number (true when not 0)"),
+                        )
+                    }
+                    Err(d) => return self.error(scope, d),
+                };
+                let home = self.env.scopes[scope].home;
+                let prefix = self.env.scopes[home].prefix.clone();
+                let inner = self.env.new_scope(Some(scope), prefix, Some(home));
+                self.mention(if c { otherwise } else { then }, scope);
+                self.items(if c { then } else { otherwise }, inner, Where::Nested, file);
             }
             Item::Export { items, span } => {
                 if at == Where::Main {

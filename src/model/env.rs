@@ -133,7 +133,7 @@ pub enum Ref {
     Builtin(Value),
 }
 
-const BUILTINS: &[&str] = &["t", "pi", "x", "y", "z"];
+const BUILTINS: &[&str] = &["t", "pi", "x", "y", "z", "true", "false"];
 
 fn builtin(name: &str) -> Option<Value> {
     let unit = |k: usize| {
@@ -150,6 +150,8 @@ fn builtin(name: &str) -> Option<Value> {
             dim: Dim::TIME,
         },
         "pi" => Value::scalar(std::f64::consts::PI, Dim::NONE),
+        "true" => Value::scalar(1.0, Dim::NONE),
+        "false" => Value::scalar(0.0, Dim::NONE),
         "x" => unit(0),
         "y" => unit(1),
         "z" => unit(2),
@@ -245,6 +247,33 @@ impl Env {
             }
         }
         s.spans.entry(name.name.clone()).or_insert(name.span);
+        Ok(())
+    }
+
+    /// Declares a value binding in `scope` itself (a loop's lets stay in the loop body).
+    pub fn declare_local(
+        &mut self,
+        scope: ScopeId,
+        name: &Ident,
+        id: BindingId,
+    ) -> Result<(), Diagnostic> {
+        let s = &mut self.scopes[scope];
+        if let Some(first) = s
+            .spans
+            .get(&name.name)
+            .copied()
+            .or_else(|| s.names.contains_key(&name.name).then_some(name.span))
+        {
+            return Err(Diagnostic::error(
+                Code::E0203,
+                format!("`{}` is declared twice", name.name),
+            )
+            .at(name.span, "second declaration")
+            .at(first, "first declared here")
+            .hint("every name in a scope must be distinct"));
+        }
+        s.names.insert(name.name.clone(), Named::Binding(id));
+        s.spans.insert(name.name.clone(), name.span);
         Ok(())
     }
 

@@ -144,8 +144,10 @@ pub struct Beam {
     pub elements: usize,
     /// Nodes per element: 2, 3 or 4.
     pub order: usize,
-    /// Node positions at t = 0.
+    /// Node positions in the undeformed reference configuration.
     pub nodes: Vec<[f64; 3]>,
+    /// Node positions at t = 0 (the reference ones unless `spin_stretch` displaces them).
+    pub initial_nodes: Vec<[f64; 3]>,
     /// Section frame at t = 0 (columns: axes 1, 2, 3), the same at every node.
     pub frame: Mat3,
     pub length: f64,

@@ -347,6 +347,31 @@ impl Builder<'_> {
                         )
                     }
                 };
+                // A node rotates: its rotation, crv and angular velocity are outputs too.
+                if let (Attach::BeamNode { .. }, Some(q)) = (attach, rest.get(1)) {
+                    let quantity = match q.name.name.as_str() {
+                        "angular_velocity" => Some(BodyQuantity::AngularVelocity),
+                        "angular_acceleration" => Some(BodyQuantity::AngularAcceleration),
+                        "rotation" => Some(BodyQuantity::Rotation),
+                        "crv" => Some(BodyQuantity::Crv),
+                        _ => None,
+                    };
+                    if let Some(quantity) = quantity {
+                        let names: &'static [&'static str] = match quantity {
+                            BodyQuantity::Rotation => &DCM,
+                            BodyQuantity::Crv => &CRV,
+                            _ => &AXES,
+                        };
+                        return self.components(scope, &rest[2..], names, |component| {
+                            Probe::Point {
+                                attach,
+                                offset: [0.0; 3],
+                                quantity,
+                                component,
+                            }
+                        });
+                    }
+                }
                 self.point_quantity(
                     scope,
                     &rest[1..],

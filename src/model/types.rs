@@ -6,6 +6,8 @@ use super::units::Dim;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamType {
     Int,
+    /// `true` or `false` (1 or 0).
+    Bool,
     /// A scalar of this dimension, constant or varying in time.
     Scalar(Dim, &'static str),
     /// A vector of this dimension.
@@ -25,6 +27,7 @@ pub enum ParamType {
 /// Every type name, its type, and an example for hints.
 pub const TYPES: &[(&str, ParamType, &str)] = &[
     ("int", ParamType::Int, "4"),
+    ("bool", ParamType::Bool, "true"),
     ("real", ParamType::Scalar(Dim::NONE, "real"), "0.5"),
     ("angle", ParamType::Scalar(Dim::NONE, "angle"), "30 deg"),
     ("length", ParamType::Scalar(Dim::LENGTH, "length"), "0.3 m"),
@@ -146,6 +149,7 @@ impl ParamType {
     pub fn describe(&self) -> String {
         match self {
             ParamType::Int => "a whole number".to_string(),
+            ParamType::Bool => "`true` or `false`".to_string(),
             ParamType::Scalar(d, n) => format!("a {n} ({})", d.describe()),
             ParamType::Vector(d, n) => format!("a {n} vector ({})", d.describe()),
             ParamType::Direction => "a direction (a non-zero dimensionless vector)".to_string(),
@@ -176,6 +180,9 @@ impl ParamType {
         };
         let ok = match (self, v) {
             (ParamType::Int, Value::Scalar { value, dim }) => dim.is_none() && value.fract() == 0.0,
+            (ParamType::Bool, Value::Scalar { value, dim }) => {
+                dim.is_none() && (*value == 0.0 || *value == 1.0)
+            }
             (ParamType::Scalar(d, _), Value::Scalar { dim, .. }) => d == dim,
             (ParamType::Scalar(d, _), Value::Signal { parts, dim }) => parts.len() == 1 && d == dim,
             (ParamType::Vector(d, _), Value::Vector { dim, .. }) => d == dim,

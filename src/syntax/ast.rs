@@ -214,6 +214,13 @@ pub enum Item {
         items: Vec<Item>,
         span: Span,
     },
+    /// `if cond { then } else { otherwise }`: the branch is chosen while elaborating.
+    If {
+        cond: Expr,
+        then: Vec<Item>,
+        otherwise: Vec<Item>,
+        span: Span,
+    },
     Export {
         items: Vec<ExportItem>,
         span: Span,
@@ -259,6 +266,7 @@ impl Item {
             | Item::Output { span, .. }
             | Item::Solve { span, .. }
             | Item::For { span, .. }
+            | Item::If { span, .. }
             | Item::Export { span, .. }
             | Item::Instance { span, .. }
             | Item::Initial { span, .. }

@@ -33,6 +33,8 @@ pub fn rule_name(rule: Rule) -> &'static str {
         Rule::body => "a `{ ... }` body of declarations",
         Rule::for_decl => "`for i in 0..N { ... }`",
         Rule::range_op => "`..` or `..=`",
+        Rule::if_decl => "`if CONDITION { ... } else { ... }`",
+        Rule::kw_else => "`else`",
         Rule::export_decl => "`export NAME, ...`",
         Rule::export_item => "an exported name",
         Rule::instance_decl => "`NAME = component(arg = value, ...)`",

@@ -91,6 +91,12 @@ fn syntax_error(e: pest::error::Error<Rule>, source: SourceId) -> Diagnostic {
         }
         ErrorVariant::CustomError { .. } => Vec::new(),
     };
+    let at_item = matches!(&e.variant, ErrorVariant::ParsingError { positives, .. } if positives.contains(&Rule::model_decl));
+    let expected = if at_item {
+        vec!["a declaration"]
+    } else {
+        expected
+    };
     let message = if expected.is_empty() {
         "unexpected text".to_string()
     } else {
@@ -286,6 +292,24 @@ impl Cx {
                     to,
                     inclusive,
                     items,
+                    span,
+                }
+            }
+            Rule::if_decl => {
+                let cond = self.expr(take(&mut it, "condition")?)?;
+                let then = self.items(take(&mut it, "branch")?.into_inner())?;
+                let mut otherwise = Vec::new();
+                for q in it {
+                    match q.as_rule() {
+                        Rule::kw_else => {}
+                        Rule::if_decl => otherwise.push(self.item(q)?),
+                        _ => otherwise = self.items(q.into_inner())?,
+                    }
+                }
+                Item::If {
+                    cond,
+                    then,
+                    otherwise,
                     span,
                 }
             }
