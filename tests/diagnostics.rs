@@ -32,7 +32,105 @@ const CASES: &[(&str, Code)] = &[
     ("marker_offset_on_point_mass", Code::E0306),
     ("unused_param", Code::W0201),
     ("several_errors", Code::E0202),
+    ("index_out_of_range", Code::E0214),
+    ("component_argument", Code::E0215),
+    ("module_not_found", Code::E0216),
+    ("runaway_recursion", Code::E0218),
+    ("not_exported", Code::E0219),
+    ("misplaced_declaration", Code::E0220),
+    ("wrong_reference", Code::E0222),
+    ("loop_too_long", Code::E0223),
+    ("declaration_shape", Code::E0224),
+    ("redundant_constraints", Code::E0307),
+    ("massless_motion", Code::E0308),
+    ("markers_apart", Code::E0310),
+    ("inertia_not_physical", Code::E0311),
+    ("varies_in_time", Code::E0401),
+    ("knots_out_of_order", Code::E0402),
+    ("piecewise_mode", Code::E0403),
+    ("driven_twice", Code::E0404),
+    ("unused_declaration", Code::W0202),
+    ("floating_body", Code::W0301),
 ];
+
+/// Codes snapshotted by the other tests of this file (run-time failures, `--set`, imports).
+const ELSEWHERE: &[Code] = &[
+    Code::E0208,
+    Code::E0217,
+    Code::E0501,
+    Code::E0601,
+    Code::E0602,
+    Code::E0603,
+    Code::E0604,
+    Code::W0601,
+    Code::W0602,
+];
+
+#[test]
+fn every_code_has_a_snapshot_case() {
+    for c in ALL_CODES {
+        assert!(
+            CASES.iter().any(|(_, k)| k == c) || ELSEWHERE.contains(c),
+            "{} has no snapshot case",
+            c.as_str()
+        );
+    }
+}
+
+/// Modules held in memory, for import tests.
+struct Modules(&'static [(&'static str, &'static str)]);
+
+impl mbd::model::Loader for Modules {
+    fn load(&self, r: &mbd::model::LoadRequest) -> Result<(String, String), Option<String>> {
+        let key = match r {
+            mbd::model::LoadRequest::Module { path, .. } => format!("{}.mbd", path.join("/")),
+            mbd::model::LoadRequest::File { path, .. } => path.to_string(),
+        };
+        self.0
+            .iter()
+            .find(|m| m.0 == key)
+            .map(|m| (m.0.to_string(), m.1.to_string()))
+            .ok_or(None)
+    }
+}
+
+#[test]
+fn import_cycles_are_reported_and_user_modules_load() {
+    let model = "model m\nuse parts::a\nground earth\np = pend(base = earth)\nsolve hht { dt = 0.01 s, until = 1 s }\n";
+    const A: &str = "use \"parts/b.mbd\"\ncomponent pend(base: marker) {\n    point_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n    joint link = distance(base, bob)\n}\n";
+    const FILES: &[(&str, &str)] = &[("parts/a.mbd", A), ("parts/b.mbd", "use parts::a\n")];
+    let cyclic = Modules(FILES);
+    let f = match mbd::compile_with("m.mbd", model, &[], Overrides::default(), &cyclic) {
+        Ok(_) => panic!("an import cycle must be an error"),
+        Err(f) => f,
+    };
+    let codes: Vec<Code> = f.diagnostics.iter().map(|d| d.code).collect();
+    assert!(codes.contains(&Code::E0217), "{codes:?}");
+    insta::assert_snapshot!("import_cycle", render_all(&f.diagnostics, &f.sources));
+    // Without the cycle the same component loads from the user's module.
+    const FINE: &[(&str, &str)] = &[("parts/a.mbd", "component pend(base: marker) {\n    point_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n    joint link = distance(base, bob)\n}\n")];
+    let fine = Modules(FINE);
+    let c = mbd::compile_with("m.mbd", model, &[], Overrides::default(), &fine);
+    match c {
+        Ok(c) => assert_eq!(c.model.bodies[0].name, "p.bob"),
+        Err(f) => panic!("{}", render_all(&f.diagnostics, &f.sources)),
+    }
+}
+
+#[test]
+fn a_valid_model_the_runtime_cannot_run_yet_says_so() {
+    let source = read("models/two_bar.mbd");
+    let c = match mbd::compile("models/two_bar.mbd", &source, &[], Overrides::default()) {
+        Ok(c) => c,
+        Err(f) => panic!("{}", render_all(&f.diagnostics, &f.sources)),
+    };
+    let d = match &c.lowered {
+        Ok(_) => panic!("rigid bodies are not lowered yet; update this test when they are"),
+        Err(d) => d.clone(),
+    };
+    assert_eq!(d.code, Code::E0501);
+    insta::assert_snapshot!("run_unsupported", render_all(&[d], &c.sources));
+}
 
 fn render_all(diags: &[Diagnostic], sources: &SourceMap) -> String {
     diags
@@ -196,6 +294,18 @@ fn runtime_diagnostics_name_when_and_where() {
             Code::E0601,
         ),
         ("run_fet_unavailable", pendulum.clone(), fet, Code::E0604),
+        (
+            "run_non_finite",
+            pendulum.replacen("param V0 = 1.5 m/s", "param V0 = 1e150 m/s", 1),
+            Overrides::default(),
+            Code::E0603,
+        ),
+        (
+            "run_singular",
+            pendulum.replacen("param V0 = 1.5 m/s", "param V0 = 1e160 m/s", 1),
+            Overrides::default(),
+            Code::E0602,
+        ),
         (
             "run_velocity_projected",
             pendulum.replace("velocity = (V0, 0, 0)", "velocity = (V0, -0.05 m/s, 0)"),

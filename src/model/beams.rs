@@ -315,7 +315,18 @@ impl Builder<'_> {
             }
         };
         let elements = match self.expr(v.scope, p.get("elements")) {
-            Some(e) => self.integer(v.scope, e, "`elements`", 1),
+            Some(e) => match self.integer(v.scope, e, "`elements`", 1) {
+                Some(n) if n > 10_000 => {
+                    self.error(
+                        v.scope,
+                        Diagnostic::error(Code::E0213, format!("beam `{}` has {n} elements", v.name))
+                            .at(e.span, "more than 10000")
+                            .hint("beams are limited to 10000 elements; a few dozen resolve a rotor blade's first modes"),
+                    );
+                    None
+                }
+                n => n,
+            },
             None => Some(1),
         };
         let order = match self.expr(v.scope, p.get("order")) {

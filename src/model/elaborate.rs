@@ -673,7 +673,7 @@ impl<'a> Elaborator<'a> {
         let (module, item): (Vec<String>, Option<Ident>) = match target {
             UseTarget::File(path) => {
                 let Some(ms) = self.load(
-                    &format!("file:{path}"),
+                    &format!("\"{path}\""),
                     LoadRequest::File { path, from: file },
                     span,
                     scope,

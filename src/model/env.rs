@@ -347,7 +347,7 @@ impl Env {
         let mut n = 0;
         while let Some(id) = s {
             if let Some((comp, span)) = &self.scopes[id].instance {
-                if n < 4 {
+                if n < 4 && !d.labels.iter().any(|l| l.span == *span) {
                     d = d.at(*span, format!("in this instance of component `{comp}`"));
                 }
                 n += 1;

@@ -24,8 +24,38 @@ fn pratt() -> &'static PrattParser<Rule> {
     })
 }
 
+/// Deepest nesting of brackets the parser accepts (deeper input would exhaust the stack).
+const MAX_NESTING: usize = 128;
+
+/// Rejects absurdly deep nesting before the recursive parser sees it.
+fn check_nesting(text: &str, source: SourceId) -> Result<(), Diagnostic> {
+    let mut depth = 0usize;
+    let mut in_comment = false;
+    for (i, c) in text.char_indices() {
+        match c {
+            '#' => in_comment = true,
+            '\n' => in_comment = false,
+            '(' | '{' | '[' if !in_comment => {
+                depth += 1;
+                if depth > MAX_NESTING {
+                    return Err(Diagnostic::error(
+                        Code::E0101,
+                        format!("brackets nest more than {MAX_NESTING} deep"),
+                    )
+                    .at(Span::new(source, i, i + 1), "too deep")
+                    .hint("simplify the expression, or split it with `let`"));
+                }
+            }
+            ')' | '}' | ']' if !in_comment => depth = depth.saturating_sub(1),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
 /// Parses a whole model file.
 pub fn parse_file(text: &str, source: SourceId) -> Result<File, Diagnostic> {
+    check_nesting(text, source)?;
     let mut pairs = MbdParser::parse(Rule::file, text).map_err(|e| syntax_error(e, source))?;
     let file = pairs
         .next()
@@ -38,6 +68,7 @@ pub fn parse_file(text: &str, source: SourceId) -> Result<File, Diagnostic> {
 
 /// Parses a standalone expression, such as the VALUE of `--set NAME=VALUE`.
 pub fn parse_expr(text: &str, source: SourceId) -> Result<Expr, Diagnostic> {
+    check_nesting(text, source)?;
     let mut pairs = MbdParser::parse(Rule::expr_only, text).map_err(|e| syntax_error(e, source))?;
     let cx = Cx { source };
     let top = pairs.next().and_then(|p| p.into_inner().next());
@@ -49,6 +80,7 @@ pub fn parse_expr(text: &str, source: SourceId) -> Result<Expr, Diagnostic> {
 
 /// Parses a `--set` argument `NAME=VALUE` held as its own source text.
 pub fn parse_set_arg(text: &str, source: SourceId) -> Result<(Ident, Expr), Diagnostic> {
+    check_nesting(text, source)?;
     let mut pairs = MbdParser::parse(Rule::set_arg, text).map_err(|e| syntax_error(e, source))?;
     let cx = Cx { source };
     let mut it = pairs
