@@ -112,6 +112,51 @@ pub fn compile_with(
     })
 }
 
+/// True if the text is a library of components rather than a model (no `model` header).
+pub fn is_library(text: &str) -> bool {
+    match syntax::parse_file(text, source::SourceId(0)) {
+        Ok(f) => {
+            !f.items
+                .iter()
+                .any(|i| matches!(i, syntax::ast::Item::Model { .. }))
+                && f.items
+                    .iter()
+                    .any(|i| matches!(i, syntax::ast::Item::Component(_)))
+        }
+        Err(_) => false,
+    }
+}
+
+/// Checks a library file; returns its components' signatures and any warnings.
+pub fn check_library(
+    name: &str,
+    text: &str,
+    loader: &dyn Loader,
+) -> Result<(Vec<String>, CompileFailure), CompileFailure> {
+    let mut sources = SourceMap::new();
+    let id = sources.add(name, text);
+    let mut sink = Sink::default();
+    let file = match syntax::parse_file(text, id) {
+        Ok(f) => f,
+        Err(d) => {
+            return Err(CompileFailure {
+                sources,
+                diagnostics: vec![d],
+            })
+        }
+    };
+    let components = model::check_library(&file, name, &mut sources, loader, &mut sink);
+    let failure = CompileFailure {
+        sources,
+        diagnostics: sink.diagnostics,
+    };
+    if failure.diagnostics.iter().any(|d| d.is_error()) {
+        Err(failure)
+    } else {
+        Ok((components, failure))
+    }
+}
+
 impl Compiled {
     /// Solver settings from the model's `solve` block (with command-line overrides applied).
     pub fn settings(&self) -> Settings {

@@ -212,6 +212,29 @@ fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> Exi
         Ok(t) => t,
         Err(code) => return code,
     };
+    if mbd::is_library(&text) {
+        return match mbd::check_library(path, &text, &FsLoader::new()) {
+            Ok((components, warnings)) => {
+                report(&warnings.diagnostics, &warnings.sources, format);
+                if format == Format::Json {
+                    println!(
+                        "{}",
+                        serde_json::json!({ "library": path, "components": components })
+                    );
+                } else {
+                    println!(
+                        "library {path}: ok\n  components\n    {}",
+                        components.join("\n    ")
+                    );
+                }
+                ExitCode::SUCCESS
+            }
+            Err(f) => {
+                report(&f.diagnostics, &f.sources, format);
+                ExitCode::from(EXIT_MODEL)
+            }
+        };
+    }
     let c = match mbd::compile_with(path, &text, sets, Overrides::default(), &FsLoader::new()) {
         Ok(c) => c,
         Err(f) => {

@@ -5,4 +5,6 @@ mod cli;
 mod common;
 mod diagnostics;
 mod grammar;
+mod models;
 mod pendulum;
+mod robustness;

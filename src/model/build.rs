@@ -229,6 +229,42 @@ pub fn build(
     Some(model)
 }
 
+/// Checks a library file (components only): its imports, names and parameter types. Returns
+/// each component's signature, `name(param: type, ...)`.
+pub fn check_library(
+    file: &ast::File,
+    file_name: &str,
+    sources: &mut SourceMap,
+    loader: &dyn Loader,
+    sink: &mut Sink,
+) -> Vec<String> {
+    let mut el = Elaborator::new(sources, loader);
+    let scope = el.library(&file.items, file_name);
+    for e in std::mem::take(&mut el.errors) {
+        sink.push(e);
+    }
+    let mut out: Vec<(u32, String)> = el.env.scopes[scope]
+        .names
+        .values()
+        .filter_map(|n| match n {
+            Named::Component(c, _) if c.span.source == file.span.source => {
+                let params: Vec<String> = c
+                    .params
+                    .iter()
+                    .map(|p| format!("{}: {}", p.name.name, p.ty.name))
+                    .collect();
+                Some((
+                    c.span.start,
+                    format!("{}({})", c.name.name, params.join(", ")),
+                ))
+            }
+            _ => None,
+        })
+        .collect();
+    out.sort();
+    out.into_iter().map(|x| x.1).collect()
+}
+
 impl Builder<'_> {
     fn view(&self, d: usize) -> Option<View> {
         let decl = &self.env.decls[d];

@@ -97,6 +97,13 @@ impl<'a> Elaborator<'a> {
         top
     }
 
+    /// Elaborates a library file as `use` would; returns its scope.
+    pub fn library(&mut self, items: &[Item], file: &str) -> ScopeId {
+        let scope = self.env.new_scope(None, String::new(), None);
+        self.items(items, scope, Where::Module, file);
+        scope
+    }
+
     fn items(&mut self, items: &[Item], scope: ScopeId, at: Where, file: &str) {
         // Names first.
         for item in items {

@@ -18,7 +18,7 @@ pub mod topology;
 mod types;
 pub mod units;
 
-pub use build::build;
+pub use build::{build, check_library};
 pub use dofs::DofMap;
 pub use eval::Value;
 
