@@ -325,6 +325,67 @@ fn components_and_loops() {
 }
 
 #[test]
+fn conditions_and_parts() {
+    check(
+        Rule::if_decl,
+        &[
+            "if elastic { beam b {} } else { rigid_rod b {} }",
+            "if n { }",
+            "if a {} else if b {} else {}",
+        ],
+        &["if { }", "if a", "if a {} else", "if a {} elif b {}"],
+    );
+    check(
+        Rule::knot,
+        &["0 s: 0 N", "5 ms : 20 N", "T: -x"],
+        &["0 s", ": 1", "0 s: "],
+    );
+    check(
+        Rule::flag,
+        &["rigid", "follower"],
+        &["rigidly", "fixed", ""],
+    );
+    check(
+        Rule::connection,
+        &["(a, b)", "(earth @ (0, 0, 1) m, bar.start)", "(a)"],
+        &["()", "(a, )", "a, b"],
+    );
+    check(
+        Rule::on_clause,
+        &["on hub", "on bar.end @ (0, 0.1, 0) m"],
+        &["on", "onhub", "at hub"],
+    );
+    check(
+        Rule::export_item,
+        &["hub", "tip = mast.end", "hub = hub_body"],
+        &["tip =", "= mast", "3"],
+    );
+    check(
+        Rule::arg,
+        &[
+            "blades = 4",
+            "hub = tower.tip",
+            "torque = T0 * ramp(0 s, 0.5 s)",
+        ],
+        &["blades", "= 4", "4 = blades"],
+    );
+    check(
+        Rule::output_item,
+        &[
+            "bob.position",
+            "x = bob.position.x",
+            "zeta[i] = rotor.lag[i - 1].angle",
+        ],
+        &["x =", "= bob", "x = 3"],
+    );
+    check(
+        Rule::index,
+        &["[i]", "[i - 1]", "[ 2 ]"],
+        &["[]", "[i", "i]"],
+    );
+}
+
+#[test]
 fn file() {
     check(
         Rule::file,

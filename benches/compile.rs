@@ -1,0 +1,29 @@
+//! Benchmarks of the compiler on the validation models: parse, elaborate the stdlib components,
+//! build, topology checks (dense ranks) and unknown numbering.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use mbd::model::Overrides;
+
+fn model(name: &str) -> String {
+    std::fs::read_to_string(format!("{}/models/{name}.mbd", env!("CARGO_MANIFEST_DIR")))
+        .unwrap_or_default()
+}
+
+fn compile(c: &mut Criterion) {
+    for (name, sets) in [
+        ("two_bar", vec![]),
+        ("windmill", vec![]),
+        ("windmill", vec!["blades=8".to_string()]),
+        ("windmill_elastic", vec![]),
+        ("rotating_beam", vec!["elements=40".to_string()]),
+    ] {
+        let text = model(name);
+        let label = format!("check {name} {}", sets.join(" "));
+        c.bench_function(label.trim(), |b| {
+            b.iter(|| mbd::compile(name, &text, &sets, Overrides::default()).is_ok())
+        });
+    }
+}
+
+criterion_group!(benches, compile);
+criterion_main!(benches);
