@@ -9,6 +9,13 @@ use mbd::source::SourceMap;
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
+/// `println!` that does not panic when stdout is closed (`mbd check ... | head`).
+macro_rules! out_line {
+    ($($arg:tt)*) => {{
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+
 #[derive(Parser)]
 #[command(
     name = "mbd",
@@ -217,12 +224,12 @@ fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> Exi
             Ok((components, warnings)) => {
                 report(&warnings.diagnostics, &warnings.sources, format);
                 if format == Format::Json {
-                    println!(
+                    out_line!(
                         "{}",
                         serde_json::json!({ "library": path, "components": components })
                     );
                 } else {
-                    println!(
+                    out_line!(
                         "library {path}: ok\n  components\n    {}",
                         components.join("\n    ")
                     );
@@ -259,7 +266,7 @@ fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> Exi
         },
         None => summary(&c, format),
     };
-    println!("{out}");
+    out_line!("{out}");
     ExitCode::SUCCESS
 }
 
@@ -289,11 +296,11 @@ fn summary(c: &mbd::Compiled, format: Format) -> String {
         Err(d) => format!("\n  note: {}", d.message),
     };
     format!(
-        "model {}: ok\n{}\n  nonzeros     {}\n  outputs      t, {}\n  solve        {} steps of {} s to {} s{runnable}",
+        "model {}: ok\n{}\n  nonzeros     {}\n  outputs      {}\n  solve        {} steps of {} s to {} s{runnable}",
         m.name,
         mbd::model::topology::report(m),
         nonzeros.map(|x| x.to_string()).unwrap_or_else(|| "-".to_string()),
-        columns.join(", "),
+        std::iter::once("t").chain(columns.iter().copied()).collect::<Vec<_>>().join(", "),
         m.solve.steps,
         m.solve.dt,
         m.solve.until

@@ -4,6 +4,7 @@ mod architecture;
 mod cli;
 mod common;
 mod diagnostics;
+mod docs;
 mod grammar;
 mod models;
 mod pendulum;

@@ -54,8 +54,8 @@ number is dimensionless.";
         "Two declarations share one name. Every param, ground, body and joint needs a distinct \
 name, and so does every output column.";
     E0204 = "E0204", "unknown unit",
-        "A unit is not one the compiler knows. Known units: kg g t m mm cm km s ms min h rad deg \
-rev rpm Hz N kN J W Pa kPa MPa GPa, combined with `*`, `/` and integer powers `^`. A unit is \
+        "A unit is not one the compiler knows. Known units: kg g m mm cm km s ms min h rad deg \
+rev rpm Hz N kN J W Pa kPa MPa GPa (`rpm` and `Hz` include the 2 pi of a cycle: 1 Hz is 2 pi rad/s), combined with `*`, `/` and integer powers `^`. A unit is \
 written right after its number, without spaces inside (`9.81 m/s^2`). To multiply a quantity by \
 a param, write the param first (`L * 2 m`) or use parentheses.";
     E0205 = "E0205", "unknown property",
@@ -74,14 +74,19 @@ overridden from the command line.";
 have three components.";
     E0210 = "E0210", "unknown function or wrong arguments",
         "A call names a function that does not exist, or passes the wrong number of arguments. \
-Functions: sin cos tan asin acos atan atan2 sqrt abs exp ln min max; constant: pi.";
+Functions: sin cos tan asin acos atan atan2 sqrt abs exp ln min max norm dot cross rotate, \
+and the time functions ramp step sine constant; a `function NAME = ...` is called with one \
+argument, the time: `pulse(t - 1 s)`.";
     E0211 = "E0211", "unknown declaration kind",
         "A declaration kind, joint kind, solver or option value is not known. The hint lists the \
 known ones.";
     E0212 = "E0212", "unknown output quantity",
         "An `output` path does not name a quantity the model can compute. Bodies provide \
-position, velocity and acceleration (and their .x .y .z components); joints provide force and \
-violation.";
+position, velocity and acceleration (and their .x .y .z components), rigid bodies also \
+angular_velocity, angular_acceleration, rotation and crv; markers and beam points provide \
+position, velocity and acceleration; joints provide force, moment and violation, revolute joints \
+angle and rate, prismatic joints displacement and speed; `kinetic_energy`, `potential_energy` \
+and `total_energy` are model outputs.";
     E0213 = "E0213", "invalid value",
         "A value is outside its allowed range or not finite: a negative time step, an HHT alpha \
 outside [-1/3, 0], a division by zero, the square root of a negative number.";
@@ -104,8 +109,7 @@ are searched next to the model file and then in the directories listed in MBD_PA
 into a third module that imports neither.";
     E0218 = "E0218", "components nested too deep",
         "Component instances nest more than 24 levels deep. This almost always means a component \
-instantiates itself, directly or through another component: recursion has no base case in a \
-declarative model.";
+instantiates itself, directly or through another component, without an `if` that stops it.";
     E0219 = "E0219", "name not exported",
         "A component declares the name, but its `export` list does not include it, so it is private \
 to the component. Add it to the component's `export` line, or use an exported name.";

@@ -407,7 +407,17 @@ impl Builder<'_> {
         ];
         let frame = mat_mul(base, rotation([1.0, 0.0, 0.0], twist));
         if Self::has_flag(v, "rigid") {
-            return self.rigid_beam(v, &section, from, length, frame, velocity, angular_velocity);
+            let nodes = elements * (order - 1) + 1;
+            return self.rigid_beam(
+                v,
+                &section,
+                from,
+                length,
+                nodes,
+                frame,
+                velocity,
+                angular_velocity,
+            );
         }
         let n = elements * (order - 1) + 1;
         let nodes: Vec<[f64; 3]> = (0..n)
@@ -483,6 +493,7 @@ impl Builder<'_> {
         s: &Section,
         from: [f64; 3],
         length: f64,
+        nodes: usize,
         frame: Mat3,
         velocity: [f64; 3],
         angular_velocity: [f64; 3],
@@ -528,6 +539,7 @@ impl Builder<'_> {
                 velocity,
                 angular_velocity,
                 markers,
+                beam_axis: Some((length, nodes)),
             },
         )
     }

@@ -132,6 +132,7 @@ impl Builder<'_> {
                 velocity,
                 angular_velocity: [0.0; 3],
                 markers: Vec::new(),
+                beam_axis: None,
             },
         )
     }
@@ -299,6 +300,7 @@ impl Builder<'_> {
                 velocity,
                 angular_velocity,
                 markers,
+                beam_axis: None,
             },
         )
     }
@@ -431,6 +433,7 @@ impl Builder<'_> {
                 velocity,
                 angular_velocity,
                 markers,
+                beam_axis: None,
             },
         )
     }
@@ -526,6 +529,9 @@ impl Builder<'_> {
                 }
                 b.mass = total;
                 b.center = c;
+                for m in b.markers.iter_mut().filter(|m| m.0 == "center") {
+                    m.1 = c;
+                }
                 Some(Built::Mass)
             }
             Attach::BeamNode { beam, node } => {
@@ -620,8 +626,18 @@ impl Builder<'_> {
             }
             Some(Built::Body(b)) => {
                 let body = self.bodies[b].clone();
+                let along =
+                    |s: &Seg| -> Option<Result<f64, Diagnostic>> { axis_point(&body, s, &text) };
                 let (local, axes) = match rest.as_slice() {
                     [] => ([0.0; 3], IDENTITY),
+                    [s] if along(s).is_some() => match along(s) {
+                        Some(Ok(x)) => ([x, 0.0, 0.0], IDENTITY),
+                        Some(Err(d)) => {
+                            self.error(scope, d);
+                            return None;
+                        }
+                        None => return None,
+                    },
                     [s] if s.index.is_none() && s.arg.is_none() => {
                         match body.markers.iter().find(|x| x.0 == s.name.name) {
                             Some(x) => (x.1, x.2),
@@ -730,13 +746,20 @@ impl Builder<'_> {
                     [s, ..] => return self.beam_point_error(scope, s.span, &text, n),
                     [] => return self.beam_point_error(scope, m.path.span, &text, n),
                 };
-                let e1 = [beam.frame[0][0], beam.frame[1][0], beam.frame[2][0]];
                 let o = offset.map(|o| o.0).unwrap_or([0.0; 3]);
+                // Where the point is at t = 0: on the initial (possibly stretched) nodes.
+                let h = beam.length / (n - 1) as f64;
+                let k = ((s / h).floor() as usize).min(n - 2);
+                let w = (s - k as f64 * h) / h;
+                let at = add(
+                    scale(beam.initial_nodes[k], 1.0 - w),
+                    scale(beam.initial_nodes[k + 1], w),
+                );
                 Marker {
                     attach,
                     offset: o,
                     axes: IDENTITY,
-                    position: add(add(beam.nodes[0], scale(e1, s)), mat_vec(beam.frame, o)),
+                    position: add(at, mat_vec(beam.frame, o)),
                     world_axes: beam.frame,
                     text: format!(
                         "{text}.{}",
@@ -791,5 +814,38 @@ impl Builder<'_> {
                 .hint(format!("write `{of}.start`, `{of}.end`, `{of}.node[k]` (k in 0..={}) or `{of}.at(s)` with s an arc length", n - 1)),
         );
         None
+    }
+}
+
+/// `at(s)` or `node[k]` on a rigid beam: the arc length along its axis, if `s` names one.
+pub(super) fn axis_point(body: &Body, s: &Seg, of: &str) -> Option<Result<f64, Diagnostic>> {
+    let (length, n) = body.beam_axis?;
+    match (s.name.name.as_str(), s.index, &s.arg) {
+        ("node", Some((k, ks)), None) => Some(if k >= 0 && (k as usize) < n {
+            Ok(length * k as f64 / (n - 1) as f64)
+        } else {
+            Err(Diagnostic::error(
+                Code::E0214,
+                format!(
+                    "node {k} is out of range: beam `{of}` has nodes 0..={}",
+                    n - 1
+                ),
+            )
+            .at(ks, "no such node")
+            .hint("a rigid beam keeps the node numbering its elements and order give"))
+        }),
+        ("at", None, Some((Value::Scalar { value, dim }, vs))) => Some(
+            if *dim == Dim::LENGTH && (0.0..=length * (1.0 + 1e-12)).contains(value) {
+                Ok(*value)
+            } else {
+                Err(Diagnostic::error(
+                    Code::E0214,
+                    format!("`at(s)` on beam `{of}` needs an arc length in [0, {length} m]"),
+                )
+                .at(*vs, "outside the beam")
+                .hint("s is the distance from the beam's start, in metres"))
+            },
+        ),
+        _ => None,
     }
 }

@@ -217,6 +217,9 @@ impl<'a> Elaborator<'a> {
                 if at == Where::Nested {
                     return self.misplaced(scope, c.span, "component", at);
                 }
+                if self.reserved(scope, &c.name) {
+                    return;
+                }
                 self.check_component(c, scope);
                 if let Err(d) =
                     self.env
@@ -280,6 +283,20 @@ impl<'a> Elaborator<'a> {
         }
     }
 
+    /// `t` is the time everywhere: no declaration, parameter or loop variable may take it.
+    fn reserved(&mut self, scope: ScopeId, name: &Ident) -> bool {
+        if name.name != "t" {
+            return false;
+        }
+        self.error(
+            scope,
+            Diagnostic::error(Code::E0203, "`t` is the time and cannot be redeclared")
+                .at(name.span, "reserved name")
+                .hint("choose another name"),
+        );
+        true
+    }
+
     fn bind(
         &mut self,
         scope: ScopeId,
@@ -288,13 +305,8 @@ impl<'a> Elaborator<'a> {
         kind: BindingKind,
         value: &crate::syntax::ast::Expr,
     ) {
-        if name.name == "t" {
-            return self.error(
-                scope,
-                Diagnostic::error(Code::E0203, "`t` is the time and cannot be redeclared")
-                    .at(name.span, "reserved name")
-                    .hint("choose another name"),
-            );
+        if self.reserved(scope, name) {
+            return;
         }
         let b = Env::binding(name, span, kind, Some(value.clone()), scope, None, None);
         let id = self.env.add_binding(b);
@@ -307,6 +319,7 @@ impl<'a> Elaborator<'a> {
     fn check_component(&mut self, c: &Component, scope: ScopeId) {
         let mut seen: HashMap<&str, Span> = HashMap::new();
         for p in &c.params {
+            self.reserved(scope, &p.name);
             if let Some(first) = seen.insert(&p.name.name, p.name.span) {
                 self.error(
                     scope,
@@ -348,6 +361,9 @@ impl<'a> Elaborator<'a> {
                 if at == Where::Module {
                     return self.misplaced(scope, *span, "a declaration", at);
                 }
+                if self.reserved(scope, &name.ident) {
+                    return;
+                }
                 let index = match &name.index {
                     Some(e) => match self.env.integer_in(scope, e, "an index") {
                         Ok(i) => Some(i),
@@ -377,6 +393,9 @@ impl<'a> Elaborator<'a> {
                 if at == Where::Module {
                     return self.misplaced(scope, *span, "an instance", at);
                 }
+                if self.reserved(scope, &name.ident) {
+                    return;
+                }
                 self.instantiate(name, component, args, *span, scope, file);
             }
             Item::For {
@@ -389,6 +408,9 @@ impl<'a> Elaborator<'a> {
             } => {
                 if at == Where::Module {
                     return self.misplaced(scope, *span, "for", at);
+                }
+                if self.reserved(scope, var) {
+                    return;
                 }
                 let bounds = self
                     .env

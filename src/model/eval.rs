@@ -294,9 +294,9 @@ fn eval_inner(expr: &Expr, names: &mut dyn Names) -> Result<Value, Diagnostic> {
         ExprKind::Neg { operand } => {
             let v = eval_inner(operand, names)?;
             match v {
-                Value::Rotation { matrix } => Ok(Value::Rotation {
-                    matrix: transpose(matrix),
-                }),
+                Value::Rotation { .. } => Err(Diagnostic::error(Code::E0209, "a rotation cannot be negated")
+                    .at(expr.span, "`-` applied to a rotation")
+                    .hint("`-` binds tighter than `*`: write `-(rotate(axis, angle) * v)` to negate the vector, or `rotate(axis, -angle)` for the inverse rotation")),
                 v => {
                     let (parts, dim) = v.parts().unwrap_or_default();
                     Ok(Value::from_parts(

@@ -120,6 +120,9 @@ pub struct Body {
     pub angular_velocity: [f64; 3],
     /// Named markers: name, offset from the reference point and axes, in the body frame.
     pub markers: Vec<(String, [f64; 3], Mat3)>,
+    /// For `beam NAME rigid`: its length and node count, so `at(s)` and `node[k]` still name
+    /// points along its axis (body axis 1 from the reference point).
+    pub beam_axis: Option<(f64, usize)>,
 }
 
 /// Sectional properties of a beam, in the section frame (axis 1 along the beam).

@@ -54,6 +54,9 @@ impl Builder<'_> {
             } else {
                 base
             };
+            // Outputs declared in a component instance are named after it: `rotor.tension`.
+            let home = self.env.scopes[scope].home;
+            let base = format!("{}{base}", self.env.scopes[home].prefix);
             let n = probes.len();
             for (suffix, probe) in probes {
                 let column = if n == 1 {
@@ -89,9 +92,12 @@ impl Builder<'_> {
         let segs = self.env.segs(scope, &item.path).ok()?;
         Some(
             segs.iter()
-                .map(|s| match s.index {
-                    Some((i, _)) => format!("{}[{i}]", s.name.name),
-                    None => s.name.name.clone(),
+                .map(|s| match (s.index, &s.arg) {
+                    (Some((i, _)), _) => format!("{}[{i}]", s.name.name),
+                    (None, Some((super::eval::Value::Scalar { value, .. }, _))) => {
+                        format!("{}({value})", s.name.name)
+                    }
+                    _ => s.name.name.clone(),
                 })
                 .collect::<Vec<_>>()
                 .join("."),
@@ -227,6 +233,31 @@ impl Builder<'_> {
         match self.built[d]? {
             Built::Body(b) => {
                 let body = self.bodies[b].clone();
+                // A point along a rigid beam: `blade.at(1 m).position`.
+                if let Some(r) = rest
+                    .first()
+                    .and_then(|s| super::bodies::axis_point(&body, s, &name))
+                {
+                    let x = match r {
+                        Ok(x) => x,
+                        Err(d) => {
+                            self.error(scope, d);
+                            return None;
+                        }
+                    };
+                    return self.point_quantity(
+                        scope,
+                        &rest[1..],
+                        path.span,
+                        &format!("a point of beam `{name}`"),
+                        |quantity, component| Probe::Point {
+                            attach: Attach::Body { body: b },
+                            offset: [x, 0.0, 0.0],
+                            quantity,
+                            component,
+                        },
+                    );
+                }
                 // A named marker first: `bar.end.position`.
                 if let Some(m) = rest
                     .first()
@@ -390,8 +421,11 @@ impl Builder<'_> {
                 let what = format!("{} joint `{name}`", kind.name());
                 let known: &[&str] = match kind {
                     JointKind::Distance { .. } => &["force", "violation"],
-                    JointKind::Revolute { .. } | JointKind::Prismatic { .. } => {
+                    JointKind::Revolute { .. } => {
                         &["angle", "rate", "force", "moment", "violation"]
+                    }
+                    JointKind::Prismatic { .. } => {
+                        &["displacement", "speed", "force", "moment", "violation"]
                     }
                     _ => &["force", "moment", "violation"],
                 };
@@ -402,8 +436,8 @@ impl Builder<'_> {
                     return self.bad_quantity(scope, q, &what, known);
                 }
                 let quantity = match q.name.name.as_str() {
-                    "angle" => JointQuantity::Angle,
-                    "rate" => JointQuantity::Rate,
+                    "angle" | "displacement" => JointQuantity::Angle,
+                    "rate" | "speed" => JointQuantity::Rate,
                     "force" => JointQuantity::Force,
                     "moment" => JointQuantity::Moment,
                     _ => JointQuantity::Violation,

@@ -1,5 +1,6 @@
 //! Physical dimensions and the unit table. Values are stored in SI; angles are dimensionless
-//! (radians), so `rad`, `deg`, `rev` are pure numbers and `rpm` is a frequency.
+//! (radians), so `rad`, `deg`, `rev` are pure numbers; `rpm` (revolutions per minute) and `Hz`
+//! (cycles per second) are frequencies that carry the 2 pi of a cycle: `1 Hz` is 2 pi rad/s.
 
 use serde::Serialize;
 use std::fmt;
@@ -149,7 +150,7 @@ pub const UNITS: &[(&str, f64, Dim)] = &[
     ("deg", std::f64::consts::PI / 180.0, Dim::NONE),
     ("rev", 2.0 * std::f64::consts::PI, Dim::NONE),
     ("rpm", 2.0 * std::f64::consts::PI / 60.0, Dim::new(0, 0, -1)),
-    ("Hz", 1.0, Dim::new(0, 0, -1)),
+    ("Hz", 2.0 * std::f64::consts::PI, Dim::new(0, 0, -1)),
     ("N", 1.0, Dim::FORCE),
     ("kN", 1e3, Dim::FORCE),
     ("J", 1.0, Dim::new(1, 2, -2)),
