@@ -683,68 +683,20 @@ impl Builder<'_> {
             Some(Built::Beam(bi)) => {
                 let beam = self.beams[bi].clone();
                 let n = beam.nodes.len();
-                let at_node = |k: usize| Attach::BeamNode { beam: bi, node: k };
-                let (attach, s) = match rest.as_slice() {
-                    [s] if s.name.name == "start" && s.index.is_none() && s.arg.is_none() => {
-                        (at_node(0), 0.0)
+                let point = match rest.as_slice() {
+                    [s] => beam_point(&beam, bi, s, &text),
+                    _ => None,
+                };
+                let (attach, s) = match point {
+                    Some(Ok(x)) => x,
+                    Some(Err(d)) => {
+                        self.error(scope, d);
+                        return None;
                     }
-                    [s] if s.name.name == "end" && s.index.is_none() && s.arg.is_none() => {
-                        (at_node(n - 1), beam.length)
+                    None => {
+                        let span = rest.first().map(|s| s.span).unwrap_or(m.path.span);
+                        return self.beam_point_error(scope, span, &text, n);
                     }
-                    [s] if s.name.name == "node" && s.arg.is_none() => {
-                        let Some((k, ks)) = s.index else {
-                            return self.beam_point_error(scope, s.span, &text, n);
-                        };
-                        if k < 0 || k as usize >= n {
-                            self.error(
-                                scope,
-                                Diagnostic::error(
-                                    Code::E0214,
-                                    format!(
-                                        "node {k} is out of range: beam `{text}` has nodes 0..={}",
-                                        n - 1
-                                    ),
-                                )
-                                .at(ks, "no such node")
-                                .hint(format!(
-                                    "{} elements of {} nodes give {n} nodes",
-                                    beam.elements, beam.order
-                                )),
-                            );
-                            return None;
-                        }
-                        (at_node(k as usize), beam.length * k as f64 / (n - 1) as f64)
-                    }
-                    [s] if s.name.name == "at" && s.index.is_none() => {
-                        let Some((Value::Scalar { value, dim }, vs)) = s.arg.clone() else {
-                            return self.beam_point_error(scope, s.span, &text, n);
-                        };
-                        if dim != Dim::LENGTH
-                            || !(0.0..=beam.length * (1.0 + 1e-12)).contains(&value)
-                        {
-                            self.error(
-                                scope,
-                                Diagnostic::error(
-                                    Code::E0214,
-                                    format!(
-                                        "`at(s)` on beam `{text}` needs an arc length in [0, {} m]",
-                                        beam.length
-                                    ),
-                                )
-                                .at(vs, "outside the beam")
-                                .hint("s is the distance from the beam's start, in metres"),
-                            );
-                            return None;
-                        }
-                        let k = value / beam.length * (n - 1) as f64;
-                        if (k - k.round()).abs() < 1e-9 {
-                            (at_node(k.round() as usize), value)
-                        } else {
-                            (Attach::BeamPoint { beam: bi, s: value }, value)
-                        }
-                    }
-                    [s, ..] => return self.beam_point_error(scope, s.span, &text, n),
-                    [] => return self.beam_point_error(scope, m.path.span, &text, n),
                 };
                 let o = offset.map(|o| o.0).unwrap_or([0.0; 3]);
                 // Where the point is at t = 0: on the initial (possibly stretched) nodes.
@@ -848,4 +800,63 @@ pub(super) fn axis_point(body: &Body, s: &Seg, of: &str) -> Option<Result<f64, D
         ),
         _ => None,
     }
+}
+
+/// The point of beam `bi` a path segment names (`start`, `end`, `node[k]`, `at(s)`), with its arc
+/// length; `None` if the segment names no point of a beam.
+pub(super) fn beam_point(
+    beam: &Beam,
+    bi: usize,
+    s: &Seg,
+    of: &str,
+) -> Option<Result<(Attach, f64), Diagnostic>> {
+    let n = beam.nodes.len();
+    let node = |k: usize| Attach::BeamNode { beam: bi, node: k };
+    Some(Ok(match (s.name.name.as_str(), s.index, &s.arg) {
+        ("start", None, None) => (node(0), 0.0),
+        ("end", None, None) => (node(n - 1), beam.length),
+        ("node", Some((k, ks)), None) => {
+            if k < 0 || k as usize >= n {
+                return Some(Err(Diagnostic::error(
+                    Code::E0214,
+                    format!(
+                        "node {k} is out of range: beam `{of}` has nodes 0..={}",
+                        n - 1
+                    ),
+                )
+                .at(ks, "no such node")
+                .hint(format!(
+                    "{} elements of {} nodes give {n} nodes",
+                    beam.elements, beam.order
+                ))));
+            }
+            (node(k as usize), beam.length * k as f64 / (n - 1) as f64)
+        }
+        ("at", None, Some((Value::Scalar { value, dim }, vs))) => {
+            if *dim != Dim::LENGTH || !(0.0..=beam.length * (1.0 + 1e-12)).contains(value) {
+                return Some(Err(Diagnostic::error(
+                    Code::E0214,
+                    format!(
+                        "`at(s)` on beam `{of}` needs an arc length in [0, {} m]",
+                        beam.length
+                    ),
+                )
+                .at(*vs, "outside the beam")
+                .hint("s is the distance from the beam's start, in metres")));
+            }
+            let k = value / beam.length * (n - 1) as f64;
+            if (k - k.round()).abs() < 1e-9 {
+                (node(k.round() as usize), *value)
+            } else {
+                (
+                    Attach::BeamPoint {
+                        beam: bi,
+                        s: *value,
+                    },
+                    *value,
+                )
+            }
+        }
+        _ => return None,
+    }))
 }

@@ -315,7 +315,6 @@ impl Builder<'_> {
             }
             Built::Beam(bi) => {
                 let beam = self.beams[bi].clone();
-                let n = beam.nodes.len();
                 let what = format!("beam `{name}`");
                 let Some(p) = rest.first() else {
                     return self.missing_quantity(
@@ -325,51 +324,13 @@ impl Builder<'_> {
                         &["start", "end", "node[k]", "at(s)"],
                     );
                 };
-                let attach = match (p.name.name.as_str(), p.index, &p.arg) {
-                    ("start", None, None) => Attach::BeamNode { beam: bi, node: 0 },
-                    ("end", None, None) => Attach::BeamNode {
-                        beam: bi,
-                        node: n - 1,
-                    },
-                    ("node", Some((k, ks)), None) => {
-                        if k < 0 || k as usize >= n {
-                            self.error(
-                                scope,
-                                Diagnostic::error(
-                                    Code::E0214,
-                                    format!(
-                                        "node {k} is out of range: beam `{name}` has nodes 0..={}",
-                                        n - 1
-                                    ),
-                                )
-                                .at(ks, "no such node")
-                                .hint(format!(
-                                    "{} elements of {} nodes give {n} nodes",
-                                    beam.elements, beam.order
-                                )),
-                            );
-                            return None;
-                        }
-                        Attach::BeamNode {
-                            beam: bi,
-                            node: k as usize,
-                        }
+                let attach = match super::bodies::beam_point(&beam, bi, p, &name) {
+                    Some(Ok((attach, _))) => attach,
+                    Some(Err(d)) => {
+                        self.error(scope, d);
+                        return None;
                     }
-                    ("at", None, Some((super::eval::Value::Scalar { value, .. }, _))) => {
-                        let k = value / beam.length * (n - 1) as f64;
-                        if (k - k.round()).abs() < 1e-9 && k >= -1e-9 && (k.round() as usize) < n {
-                            Attach::BeamNode {
-                                beam: bi,
-                                node: k.round() as usize,
-                            }
-                        } else {
-                            Attach::BeamPoint {
-                                beam: bi,
-                                s: *value,
-                            }
-                        }
-                    }
-                    _ => {
+                    None => {
                         return self.bad_quantity(
                             scope,
                             p,
