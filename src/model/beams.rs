@@ -73,41 +73,26 @@ impl Builder<'_> {
             k = self.matrix6(v, sp)?;
         } else {
             for (i, (key, dim)) in DIAG.iter().enumerate() {
-                match self.expr(v.scope, p.get(key)) {
-                    Some(e) => match self.scalar(v.scope, e, *dim, &format!("`{key}`")) {
-                        Some(x) => k[i][i] = x,
-                        None => ok = false,
-                    },
-                    None => {
-                        if !p.contains_key(key) {
-                            self.missing(
-                                v.scope,
-                                block.span,
-                                key,
-                                "a section",
-                                if i < 3 { "8.53e7 N" } else { "1.28e4 N*m^2" },
-                            );
-                        }
-                        ok = false;
-                    }
+                let example = if i < 3 { "8.53e7 N" } else { "1.28e4 N*m^2" };
+                match self
+                    .required(v.scope, &p, key, block.span, "a section", example)
+                    .and_then(|e| self.scalar(v.scope, e, *dim, &format!("`{key}`")))
+                {
+                    Some(x) => k[i][i] = x,
+                    None => ok = false,
                 }
             }
         }
-        let mass = match self.expr(v.scope, p.get("mass_per_length")) {
-            Some(e) => self.scalar(v.scope, e, Dim::new(1, -1, 0), "`mass_per_length`"),
-            None => {
-                if !p.contains_key("mass_per_length") {
-                    self.missing(
-                        v.scope,
-                        block.span,
-                        "mass_per_length",
-                        "a section",
-                        "3.29 kg/m",
-                    );
-                }
-                None
-            }
-        };
+        let mass = self
+            .required(
+                v.scope,
+                &p,
+                "mass_per_length",
+                block.span,
+                "a section",
+                "3.29 kg/m",
+            )
+            .and_then(|e| self.scalar(v.scope, e, Dim::new(1, -1, 0), "`mass_per_length`"));
         let get = |this: &mut Self, key: &str, dim: Dim| match this.expr(v.scope, p.get(key)) {
             Some(e) => this.scalar(v.scope, e, dim, &format!("`{key}`")),
             None => Some(0.0),
@@ -289,14 +274,9 @@ impl Builder<'_> {
             ],
             "a beam",
         );
-        let get = |this: &mut Self, key: &str| match this.expr(v.scope, p.get(key)) {
-            Some(e) => this.vector(v.scope, e, Dim::LENGTH, &format!("`{key}`")),
-            None => {
-                if !p.contains_key(key) {
-                    this.missing(v.scope, v.name_span, key, &of, "(0, 0, 0) m");
-                }
-                None
-            }
+        let get = |this: &mut Self, key: &str| {
+            this.required(v.scope, &p, key, v.name_span, &of, "(0, 0, 0) m")
+                .and_then(|e| this.vector(v.scope, e, Dim::LENGTH, &format!("`{key}`")))
         };
         let from = get(self, "from");
         let to = get(self, "to");

@@ -99,24 +99,12 @@ impl Builder<'_> {
             "a point_mass",
         );
         self.no_markers(v, "a point_mass");
-        let mass = match self.expr(v.scope, p.get("mass")) {
-            Some(e) => self.positive_mass(v, e, false),
-            None => {
-                if !p.contains_key("mass") {
-                    self.missing(v.scope, v.name_span, "mass", &of, "1 kg");
-                }
-                None
-            }
-        };
-        let position = match self.expr(v.scope, p.get("at")) {
-            Some(e) => self.vector(v.scope, e, Dim::LENGTH, "`at`"),
-            None => {
-                if !p.contains_key("at") {
-                    self.missing(v.scope, v.name_span, "at", &of, "(0, 0, 0) m");
-                }
-                None
-            }
-        };
+        let mass = self
+            .required(v.scope, &p, "mass", v.name_span, &of, "1 kg")
+            .and_then(|e| self.positive_mass(v, e, false));
+        let position = self
+            .required(v.scope, &p, "at", v.name_span, &of, "(0, 0, 0) m")
+            .and_then(|e| self.vector(v.scope, e, Dim::LENGTH, "`at`"));
         let (velocity, _) = self.motion(v, &p);
         self.push_body(
             v,
@@ -242,15 +230,9 @@ impl Builder<'_> {
             ],
             "a rigid body",
         );
-        let mass = match self.expr(v.scope, p.get("mass")) {
-            Some(e) => self.positive_mass(v, e, true),
-            None => {
-                if !p.contains_key("mass") {
-                    self.missing(v.scope, v.name_span, "mass", &of, "2 kg");
-                }
-                None
-            }
-        };
+        let mass = self
+            .required(v.scope, &p, "mass", v.name_span, &of, "2 kg")
+            .and_then(|e| self.positive_mass(v, e, true));
         let center = match self.expr(v.scope, p.get("center")) {
             Some(e) => self.vector(v.scope, e, Dim::LENGTH, "`center`"),
             None => Some([0.0; 3]),
@@ -357,26 +339,15 @@ impl Builder<'_> {
             &["from", "to", "mass", "velocity", "angular_velocity"],
             "a rigid_rod",
         );
-        let get = |this: &mut Self, key: &str| match this.expr(v.scope, p.get(key)) {
-            Some(e) => this.vector(v.scope, e, Dim::LENGTH, &format!("`{key}`")),
-            None => {
-                if !p.contains_key(key) {
-                    this.missing(v.scope, v.name_span, key, &of, "(0, 0, 0) m");
-                }
-                None
-            }
+        let get = |this: &mut Self, key: &str| {
+            this.required(v.scope, &p, key, v.name_span, &of, "(0, 0, 0) m")
+                .and_then(|e| this.vector(v.scope, e, Dim::LENGTH, &format!("`{key}`")))
         };
         let from = get(self, "from");
         let to = get(self, "to");
-        let mass = match self.expr(v.scope, p.get("mass")) {
-            Some(e) => self.positive_mass(v, e, false),
-            None => {
-                if !p.contains_key("mass") {
-                    self.missing(v.scope, v.name_span, "mass", &of, "1 kg");
-                }
-                None
-            }
-        };
+        let mass = self
+            .required(v.scope, &p, "mass", v.name_span, &of, "1 kg")
+            .and_then(|e| self.positive_mass(v, e, false));
         let (velocity, angular_velocity) = self.motion(v, &p);
         let (from, to, mass) = (from?, to?, mass?);
         let d = sub(to, from);
@@ -456,21 +427,16 @@ impl Builder<'_> {
             "a concentrated_mass",
         );
         let on = v.on.clone()?;
-        let mass = match self.expr(v.scope, p.get("mass")) {
-            Some(e) => self.positive_mass(v, e, false),
-            None => {
-                if !p.contains_key("mass") {
-                    self.missing(
-                        v.scope,
-                        v.name_span,
-                        "mass",
-                        &format!("concentrated_mass `{}`", v.name),
-                        "2 kg",
-                    );
-                }
-                None
-            }
-        };
+        let mass = self
+            .required(
+                v.scope,
+                &p,
+                "mass",
+                v.name_span,
+                &format!("concentrated_mass `{}`", v.name),
+                "2 kg",
+            )
+            .and_then(|e| self.positive_mass(v, e, false));
         let inertia = match self.expr(v.scope, p.get("inertia")) {
             Some(e) => self.vector(
                 v.scope,

@@ -93,21 +93,7 @@ pub fn build(
     let mut el = Elaborator::new(sources, loader);
     el.sets = overrides.sets.clone();
     let top = el.main(&file.items, file_name);
-    let errors = std::mem::take(&mut el.errors);
-    let out = std::mem::replace(
-        &mut el.out,
-        super::elaborate::Elaborated {
-            header: None,
-            gravity: None,
-            solve: None,
-            outputs: Vec::new(),
-            initials: Vec::new(),
-            local_components: Vec::new(),
-            instantiated: Default::default(),
-        },
-    );
-    let env = std::mem::take(&mut el.env);
-    drop(el);
+    let (env, out, errors) = el.finish();
     for e in errors {
         sink.push(e);
     }
@@ -444,6 +430,25 @@ impl Builder<'_> {
                     .at(b.span, "a block")
                     .hint(format!("write `{} = value`", p.name.name)),
                 );
+                None
+            }
+        }
+    }
+
+    /// A required property's expression; reports it missing (E0206) when it is not written.
+    pub fn required<'p>(
+        &mut self,
+        scope: ScopeId,
+        p: &'p HashMap<&'static str, Prop>,
+        key: &str,
+        at: Span,
+        of: &str,
+        example: &str,
+    ) -> Option<&'p Expr> {
+        match p.get(key) {
+            Some(prop) => self.expr(scope, Some(prop)),
+            None => {
+                self.missing(scope, at, key, of, example);
                 None
             }
         }

@@ -136,14 +136,9 @@ impl Builder<'_> {
         let size = 1.0f64
             .max(norm(pair[0].position))
             .max(norm(pair[1].position));
-        let axis = |this: &mut Self, key: &str| match this.expr(scope, p.get(key)) {
-            Some(e) => this.direction(scope, e, &format!("`{key}`")),
-            None => {
-                if !p.contains_key(key) {
-                    this.missing(scope, kind.span, key, &format!("joint `{qname}`"), "z");
-                }
-                None
-            }
+        let axis = |this: &mut Self, key: &str| {
+            this.required(scope, &p, key, kind.span, &format!("joint `{qname}`"), "z")
+                .and_then(|e| this.direction(scope, e, &format!("`{key}`")))
         };
         let coincide = |this: &mut Self, along: Option<[f64; 3]>| {
             let off = match along {

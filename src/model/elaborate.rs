@@ -29,6 +29,7 @@ enum Where {
     Nested,
 }
 
+#[derive(Default)]
 pub struct Elaborated {
     pub header: Option<(Ident, Option<String>, Span)>,
     pub gravity: Option<(crate::syntax::ast::Expr, Span)>,
@@ -63,15 +64,7 @@ impl<'a> Elaborator<'a> {
         Elaborator {
             env: Env::default(),
             errors: Vec::new(),
-            out: Elaborated {
-                header: None,
-                gravity: None,
-                solve: None,
-                outputs: Vec::new(),
-                initials: Vec::new(),
-                local_components: Vec::new(),
-                instantiated: HashSet::new(),
-            },
+            out: Elaborated::default(),
             sources,
             loader,
             modules: HashMap::new(),
@@ -80,6 +73,11 @@ impl<'a> Elaborator<'a> {
             file_names: Vec::new(),
             sets: Vec::new(),
         }
+    }
+
+    /// What elaboration produced: the environment, the model-level items, and the errors.
+    pub fn finish(self) -> (Env, Elaborated, Vec<Diagnostic>) {
+        (self.env, self.out, self.errors)
     }
 
     fn error(&mut self, scope: ScopeId, d: Diagnostic) {
