@@ -22,15 +22,16 @@ fn compile(path: &str, sets: &[&str]) -> mbd::Compiled {
             );
             c
         }
-        Err(f) => panic!(
-            "{path} {sets:?} does not compile:\n{}",
-            f.diagnostics
-                .iter()
-                .map(|d| render_human(d, &f.sources, false))
-                .collect::<Vec<_>>()
-                .join("\n")
-        ),
+        Err(f) => panic!("{path} {sets:?} does not compile:\n{}", rendered(&f)),
     }
+}
+
+fn rendered(f: &mbd::CompileFailure) -> String {
+    f.diagnostics
+        .iter()
+        .map(|d| render_human(d, &f.sources, false))
+        .collect::<Vec<_>>()
+        .join("\n")
 }
 
 fn columns(m: &Model) -> Vec<String> {
@@ -371,13 +372,7 @@ fn stdlib_rods_instantiate() {
     );
     let c = match mbd::compile("rods.mbd", &text, &[], Overrides::default()) {
         Ok(c) => c,
-        Err(f) => panic!(
-            "{:?}",
-            f.diagnostics
-                .iter()
-                .map(|d| render_human(d, &f.sources, false))
-                .collect::<Vec<_>>()
-        ),
+        Err(f) => panic!("{}", rendered(&f)),
     };
     assert_eq!(c.model.bodies.len(), 2);
     assert_eq!(columns(&c.model), vec!["arm.hinge.angle"]);

@@ -109,29 +109,17 @@ impl Rows<'_> {
         }
     }
 
-    fn lock_translation(&mut self, j: &Joint, dir: [f64; 3]) {
+    fn lock_translation(&mut self, m: &[Marker; 2], dir: [f64; 3]) {
         let mut row = vec![0.0; self.cols.n];
-        self.translation(
-            &mut row,
-            &j.markers[1].attach,
-            j.markers[1].position,
-            dir,
-            1.0,
-        );
-        self.translation(
-            &mut row,
-            &j.markers[0].attach,
-            j.markers[0].position,
-            dir,
-            -1.0,
-        );
+        self.translation(&mut row, &m[1].attach, m[1].position, dir, 1.0);
+        self.translation(&mut row, &m[0].attach, m[0].position, dir, -1.0);
         self.rows.push(row);
     }
 
-    fn lock_rotation(&mut self, j: &Joint, dir: [f64; 3]) {
+    fn lock_rotation(&mut self, m: &[Marker; 2], dir: [f64; 3]) {
         let mut row = vec![0.0; self.cols.n];
-        self.rotation(&mut row, &j.markers[1].attach, dir, 1.0);
-        self.rotation(&mut row, &j.markers[0].attach, dir, -1.0);
+        self.rotation(&mut row, &m[1].attach, dir, 1.0);
+        self.rotation(&mut row, &m[0].attach, dir, -1.0);
         self.rows.push(row);
     }
 }
@@ -153,45 +141,45 @@ const E: [[f64; 3]; 3] = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 /// The constraint rows of one joint, in the order of its multipliers.
 fn joint_rows(r: &mut Rows, j: &Joint) {
     match &j.kind {
-        JointKind::Spherical => E.iter().for_each(|e| r.lock_translation(j, *e)),
+        JointKind::Spherical => E.iter().for_each(|e| r.lock_translation(&j.markers, *e)),
         JointKind::Fixed => {
-            E.iter().for_each(|e| r.lock_translation(j, *e));
-            E.iter().for_each(|e| r.lock_rotation(j, *e));
+            E.iter().for_each(|e| r.lock_translation(&j.markers, *e));
+            E.iter().for_each(|e| r.lock_rotation(&j.markers, *e));
         }
         JointKind::Revolute { axis, drive, .. } => {
-            E.iter().for_each(|e| r.lock_translation(j, *e));
+            E.iter().for_each(|e| r.lock_translation(&j.markers, *e));
             let (a, b) = perpendiculars(*axis);
-            r.lock_rotation(j, a);
-            r.lock_rotation(j, b);
+            r.lock_rotation(&j.markers, a);
+            r.lock_rotation(&j.markers, b);
             if !matches!(drive, Drive::Free) {
-                r.lock_rotation(j, *axis);
+                r.lock_rotation(&j.markers, *axis);
             }
         }
         JointKind::Prismatic { axis, drive, .. } => {
             let (a, b) = perpendiculars(*axis);
-            r.lock_translation(j, a);
-            r.lock_translation(j, b);
-            E.iter().for_each(|e| r.lock_rotation(j, *e));
+            r.lock_translation(&j.markers, a);
+            r.lock_translation(&j.markers, b);
+            E.iter().for_each(|e| r.lock_rotation(&j.markers, *e));
             if !matches!(drive, Drive::Free) {
-                r.lock_translation(j, *axis);
+                r.lock_translation(&j.markers, *axis);
             }
         }
         JointKind::Cylindrical { axis } => {
             let (a, b) = perpendiculars(*axis);
-            r.lock_translation(j, a);
-            r.lock_translation(j, b);
-            r.lock_rotation(j, a);
-            r.lock_rotation(j, b);
+            r.lock_translation(&j.markers, a);
+            r.lock_translation(&j.markers, b);
+            r.lock_rotation(&j.markers, a);
+            r.lock_rotation(&j.markers, b);
         }
         JointKind::Universal { axis_a, axis_b } => {
-            E.iter().for_each(|e| r.lock_translation(j, *e));
+            E.iter().for_each(|e| r.lock_translation(&j.markers, *e));
             let c = cross(*axis_a, *axis_b);
-            r.lock_rotation(j, c.map(|x| x / norm(c)));
+            r.lock_rotation(&j.markers, c.map(|x| x / norm(c)));
         }
         JointKind::Distance { .. } => {
             let d = sub(j.markers[1].position, j.markers[0].position);
             let n = norm(d);
-            r.lock_translation(j, d.map(|x| x / n));
+            r.lock_translation(&j.markers, d.map(|x| x / n));
         }
     }
 }
@@ -463,33 +451,10 @@ fn massless(model: &Model, r: &mut Rows, sink: &mut Sink) {
             SpringKind::Linear => {
                 let d = sub(sp.markers[1].position, sp.markers[0].position);
                 if norm(d) > 0.0 {
-                    let dir = d.map(|x| x / norm(d));
-                    let mut row = vec![0.0; n];
-                    r.translation(
-                        &mut row,
-                        &sp.markers[1].attach,
-                        sp.markers[1].position,
-                        dir,
-                        1.0,
-                    );
-                    r.translation(
-                        &mut row,
-                        &sp.markers[0].attach,
-                        sp.markers[0].position,
-                        dir,
-                        -1.0,
-                    );
-                    r.rows.push(row);
+                    r.lock_translation(&sp.markers, d.map(|x| x / norm(d)));
                 }
             }
-            SpringKind::Torsional => {
-                for e in E {
-                    let mut row = vec![0.0; n];
-                    r.rotation(&mut row, &sp.markers[1].attach, e, 1.0);
-                    r.rotation(&mut row, &sp.markers[0].attach, e, -1.0);
-                    r.rows.push(row);
-                }
-            }
+            SpringKind::Torsional => E.iter().for_each(|e| r.lock_rotation(&sp.markers, *e)),
         }
     }
     // Joint springs restrain the joint's free motion too.
@@ -500,13 +465,13 @@ fn massless(model: &Model, r: &mut Rows, sink: &mut Sink) {
                 spring,
                 damper,
                 ..
-            } if *spring > 0.0 || *damper > 0.0 => r.lock_rotation(j, *axis),
+            } if *spring > 0.0 || *damper > 0.0 => r.lock_rotation(&j.markers, *axis),
             JointKind::Prismatic {
                 axis,
                 spring,
                 damper,
                 ..
-            } if *spring > 0.0 || *damper > 0.0 => r.lock_translation(j, *axis),
+            } if *spring > 0.0 || *damper > 0.0 => r.lock_translation(&j.markers, *axis),
             _ => {}
         }
     }
