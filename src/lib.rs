@@ -25,7 +25,10 @@ use diagnostics::{Code, Diagnostic, Sink};
 use lower::Provenance;
 use model::{Loader, Model, NoFiles, Overrides};
 use runtime::System;
-use solve::{FailureKind, Method, NoticeKind, RunStats, RuntimeFailure, Settings, StartMode};
+use solve::{
+    FailureKind, Method, NoticeKind, RotationTreatment, RunStats, RuntimeFailure, Settings,
+    StartMode,
+};
 use source::SourceMap;
 use std::io::Write;
 
@@ -164,9 +167,15 @@ impl Compiled {
         Settings {
             method: match s.integrator {
                 model::Integrator::Hht => Method::Hht,
+                model::Integrator::GeneralizedAlpha => Method::GeneralizedAlpha,
                 model::Integrator::Fet => Method::Fet,
             },
             alpha: s.alpha,
+            rho_inf: s.rho_inf,
+            rotation: match s.rotations {
+                model::Rotations::Incremental => RotationTreatment::Incremental,
+                model::Rotations::Conformal => RotationTreatment::Conformal,
+            },
             dt: s.dt,
             steps: s.steps,
             every: s.every,
@@ -177,7 +186,7 @@ impl Compiled {
             increment_tolerance: s.tolerance,
             residual_tolerance: 1e-8,
             max_iterations: s.max_iterations,
-            max_halvings: 3,
+            max_halvings: 1,
         }
     }
 
@@ -187,7 +196,7 @@ impl Compiled {
             FailureKind::NewtonDiverged => (Code::E0601, "Newton iteration failed", "try a smaller time step (--dt), more numerical dissipation (--alpha -0.3), or check for a load or motion that is discontinuous or too large"),
             FailureKind::Singular => (Code::E0602, "singular iteration matrix", "check that every body has a positive mass and that no two joints constrain the same motion"),
             FailureKind::NonFinite => (Code::E0603, "non-finite values", "try a smaller time step (--dt); check params for extreme values"),
-            FailureKind::Unsupported => (Code::E0604, "integrator not available", "use `--integrator hht`"),
+            FailureKind::Unsupported => (Code::E0604, "integrator not available", "use `--integrator hht` or `--integrator generalized-alpha`"),
         };
         let Ok(l) = &self.lowered else {
             return Diagnostic::error(code, what.to_string()).hint(hint);
@@ -288,7 +297,7 @@ pub fn run(c: &Compiled, out: &mut dyn Write) -> Result<RunReport, RunFailure> {
             rows,
         }
     };
-    let mut hht = match solve::Hht::new(sys, &set) {
+    let mut hht = match solve::Integrator::new(sys, &set) {
         Ok(h) => h,
         Err(f) => return Err(fail(f, &mut csv, warnings, 0)),
     };

@@ -4,7 +4,7 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use mbd::diagnostics::{explain, render_human, render_json, Diagnostic};
-use mbd::model::{Integrator, Overrides, Start};
+use mbd::model::{Integrator, Overrides, Rotations, Start};
 use mbd::source::SourceMap;
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
@@ -45,6 +45,12 @@ enum Command {
         /// HHT alpha, in [-1/3, 0].
         #[arg(long, allow_negative_numbers = true)]
         alpha: Option<f64>,
+        /// Generalized-alpha spectral radius at infinity, in [0, 1].
+        #[arg(long)]
+        rho_inf: Option<f64>,
+        /// Rotation treatment: incremental (default) or conformal (the paper's).
+        #[arg(long, value_enum)]
+        rotations: Option<RotationsArg>,
         /// Time step in seconds.
         #[arg(long, conflicts_with = "steps")]
         dt: Option<f64>,
@@ -82,7 +88,14 @@ enum Command {
 #[derive(Clone, Copy, ValueEnum)]
 enum IntegratorArg {
     Hht,
+    GeneralizedAlpha,
     Fet,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RotationsArg {
+    Incremental,
+    Conformal,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -141,6 +154,8 @@ fn main() -> ExitCode {
             set,
             integrator,
             alpha,
+            rho_inf,
+            rotations,
             dt,
             steps,
             until,
@@ -148,6 +163,11 @@ fn main() -> ExitCode {
             start,
             format,
         } => {
+            if let Some(r) = rho_inf {
+                if !(0.0..=1.0).contains(&r) {
+                    return usage(&format!("--rho-inf {r} is outside [0, 1]"));
+                }
+            }
             if let Some(a) = alpha {
                 if !(-1.0 / 3.0 - 1e-12..=0.0).contains(&a) {
                     return usage(&format!("--alpha {a} is outside [-1/3, 0]"));
@@ -169,9 +189,15 @@ fn main() -> ExitCode {
                 sets: Vec::new(),
                 integrator: integrator.map(|i| match i {
                     IntegratorArg::Hht => Integrator::Hht,
+                    IntegratorArg::GeneralizedAlpha => Integrator::GeneralizedAlpha,
                     IntegratorArg::Fet => Integrator::Fet,
                 }),
                 alpha,
+                rho_inf,
+                rotations: rotations.map(|r| match r {
+                    RotationsArg::Incremental => Rotations::Incremental,
+                    RotationsArg::Conformal => Rotations::Conformal,
+                }),
                 dt,
                 steps,
                 until,

@@ -119,13 +119,18 @@ fn import_cycles_are_reported_and_user_modules_load() {
 
 #[test]
 fn a_valid_model_the_runtime_cannot_run_yet_says_so() {
-    let source = read("models/two_bar.mbd");
-    let c = match mbd::compile("models/two_bar.mbd", &source, &[], Overrides::default()) {
+    let source = read("models/two_bar_beams.mbd");
+    let c = match mbd::compile(
+        "models/two_bar_beams.mbd",
+        &source,
+        &[],
+        Overrides::default(),
+    ) {
         Ok(c) => c,
         Err(f) => panic!("{}", render_all(&f.diagnostics, &f.sources)),
     };
     let d = match &c.lowered {
-        Ok(_) => panic!("rigid bodies are not lowered yet; update this test when they are"),
+        Ok(_) => panic!("beams are not lowered yet; update this test when they are"),
         Err(d) => d.clone(),
     };
     assert_eq!(d.code, Code::E0501);

@@ -1,15 +1,23 @@
 //! Lowering: Model -> runtime System + provenance.
 //!
-//! Contract: assigns global indices from the model's DOF map, turns bodies and joints into
-//! elements, outputs into probes, and records for every runtime entity the span it came from.
-//! Raises no user errors: the model stage has caught them.
+//! Contract: assigns global indices from the model's DOF map, turns bodies, joints, springs
+//! and loads into elements and outputs into probes, and records for every runtime entity the
+//! span it came from. Raises no user errors (the model stage has caught them), except E0501
+//! for what this version's runtime cannot simulate (beams).
+
+mod joints;
 
 use crate::diagnostics::{Code, Diagnostic};
 use crate::model::dofs::Unknown;
 use crate::model::{
-    Attach, BodyKind, BodyQuantity, JointKind, JointQuantity, Model, Probe as ModelProbe,
+    Attach, Body, BodyKind, BodyQuantity, EnergyKind as ModelEnergy, JointQuantity, Marker, Model,
+    Probe as ModelProbe,
 };
-use crate::runtime::{Anchor, Channel, Element, Entity, Probe, State, System, UnknownKind};
+use crate::runtime::rotation::{M3, V3};
+use crate::runtime::{
+    arr3, m3, Channel, Element, End, EnergyKind, Entity, NodeRotation, PointMass, Probe,
+    ProbeQuantity, RigidBody, State, System, UnknownKind,
+};
 use crate::source::Span;
 
 /// Where each runtime entity was declared (index = entity index of the System).
@@ -24,42 +32,62 @@ fn unsupported(model: &Model) -> Option<Diagnostic> {
         Some(
             Diagnostic::error(Code::E0501, format!("{what} cannot be simulated by this version of the runtime"))
                 .at(span, "declared here")
-                .hint("the model is valid (`mbd check` accepts it); this version simulates point masses, distance joints and gravity only"),
+                .hint("the model is valid (`mbd check` accepts it); this version simulates point masses, rigid bodies, joints, springs and loads, not elastic beams yet"),
         )
     };
-    if let Some(b) = model.bodies.iter().find(|b| b.kind == BodyKind::Rigid) {
-        return not_yet(format!("rigid body `{}`", b.name), b.span);
-    }
     if let Some(b) = model.beams.first() {
         return not_yet(format!("beam `{}`", b.name), b.span);
     }
-    if let Some(j) = model
-        .joints
-        .iter()
-        .find(|j| !matches!(j.kind, JointKind::Distance { .. }))
-    {
-        return not_yet(format!("{} joint `{}`", j.kind.name(), j.name), j.span);
-    }
-    if let Some(s) = model.springs.first() {
-        return not_yet(format!("spring `{}`", s.name), s.span);
-    }
-    if let Some(l) = model.loads.first() {
-        return not_yet(format!("load `{}`", l.name), l.span);
-    }
-    if let Some(o) = model.outputs.iter().find(|o| {
-        !matches!(
-            o.probe,
-            ModelProbe::Body {
-                quantity: BodyQuantity::Position
-                    | BodyQuantity::Velocity
-                    | BodyQuantity::Acceleration,
-                ..
-            } | ModelProbe::Joint { .. }
-        )
-    }) {
-        return not_yet(format!("output `{}`", o.column), o.span);
-    }
     None
+}
+
+/// The lowering context: the model and the index maps.
+pub(crate) struct Lower<'m> {
+    pub model: &'m Model,
+    /// Rotating node of each body (rigid bodies only).
+    pub node_of: Vec<Option<usize>>,
+}
+
+impl Lower<'_> {
+    /// The unknowns of a body: 3 (point mass) or 6 (rigid: translation then rotation).
+    pub fn body_dofs(&self, b: usize) -> Vec<usize> {
+        let s = self.model.dofs.body_start[b];
+        let n = if self.node_of[b].is_some() { 6 } else { 3 };
+        (s..s + n).collect()
+    }
+
+    /// A marker as a runtime end, with its axes `axes` (inertial, at t = 0).
+    pub fn end(&self, m: &Marker, axes: &M3) -> End {
+        self.end_at(&m.attach, V3::from(m.position), axes)
+    }
+
+    /// The end of a point fixed on an attachment, at `position` (inertial, at t = 0).
+    pub fn end_at(&self, attach: &Attach, position: V3, axes: &M3) -> End {
+        let axes = arr3(axes);
+        match *attach {
+            Attach::Body { body } => {
+                let b = &self.model.bodies[body];
+                let d = self.body_dofs(body);
+                match self.node_of[body] {
+                    Some(node) => End::Node {
+                        dofs: [d[0], d[1], d[2], d[3], d[4], d[5]],
+                        node,
+                        offset: (position - V3::from(b.position)).into(),
+                        axes,
+                    },
+                    None => End::Point {
+                        dofs: [d[0], d[1], d[2]],
+                        axes,
+                    },
+                }
+            }
+            // Grounds, and beam points (not reached: beams are rejected before).
+            _ => End::Ground {
+                point: position.into(),
+                axes,
+            },
+        }
+    }
 }
 
 pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
@@ -68,134 +96,247 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
     }
     let dofs = &model.dofs;
     let n = dofs.len();
-    let nb = model.bodies.len();
+    let mut node_of = Vec::new();
+    let mut rotations = Vec::new();
+    let mut translations = Vec::new();
+    for (bi, b) in model.bodies.iter().enumerate() {
+        if b.kind == BodyKind::Rigid {
+            node_of.push(Some(rotations.len()));
+            rotations.push(dofs.body_start[bi] + 3);
+            translations.push(dofs.body_start[bi]);
+        } else {
+            node_of.push(None);
+        }
+    }
+    let lw = Lower { model, node_of };
     let mut entities = Vec::new();
     let mut spans = Vec::new();
     for b in &model.bodies {
         entities.push(Entity {
             name: b.name.clone(),
-            kind: "point_mass".to_string(),
+            kind: match b.kind {
+                BodyKind::PointMass => "point mass",
+                BodyKind::Rigid => "rigid body",
+            }
+            .to_string(),
         });
         spans.push(b.span);
     }
+    let nb = entities.len();
     for j in &model.joints {
         entities.push(Entity {
             name: j.name.clone(),
-            kind: "distance joint".to_string(),
+            kind: format!("{} joint", j.kind.name()),
         });
         spans.push(j.span);
     }
-    let mut unknowns = Vec::with_capacity(n);
-    let mut owners = Vec::with_capacity(n);
-    for u in &dofs.unknowns {
-        match *u {
-            Unknown::Translation { body, .. } => {
-                unknowns.push(UnknownKind::Coordinate);
-                owners.push(body);
-            }
-            Unknown::Multiplier { joint, .. } => {
-                unknowns.push(UnknownKind::Multiplier);
-                owners.push(nb + joint);
-            }
-            _ => {
-                return Err(Diagnostic::error(
-                    Code::E0501,
-                    "internal: unknown kind not lowered",
-                ))
-            }
-        }
-    }
-    let body_dofs = |b: usize| {
-        let s = dofs.body_start[b];
-        [s, s + 1, s + 2]
-    };
     let mut elements = Vec::new();
-    let mut initial = State::zeros(n);
+    let mut initial = State::zeros(n, rotations.len());
     for (bi, b) in model.bodies.iter().enumerate() {
-        let d = body_dofs(bi);
-        elements.push(Element::PointMass {
-            dofs: d,
-            mass: b.mass,
-            gravity: model.gravity,
-        });
+        let d = lw.body_dofs(bi);
         for k in 0..3 {
             initial.q[d[k]] = b.position[k];
             initial.v[d[k]] = b.velocity[k];
         }
-    }
-    // Joint j is element nb + j.
-    let mut length_scale: f64 = 0.0;
-    for (ji, j) in model.joints.iter().enumerate() {
-        let anchor = |m: &crate::model::Marker| match m.attach {
-            Attach::Body { body } => Anchor::Node {
-                dofs: body_dofs(body),
-            },
-            _ => Anchor::Fixed { point: m.offset },
-        };
-        if let JointKind::Distance { length } = j.kind {
-            {
-                length_scale = length_scale.max(length);
-                elements.push(Element::Distance {
-                    a: anchor(&j.markers[0]),
-                    b: anchor(&j.markers[1]),
-                    length,
-                    multiplier: dofs.joint_start[ji],
-                });
+        match lw.node_of[bi] {
+            Some(node) => {
+                elements.push(Element::RigidBody(rigid(b, &d, node, model.gravity)));
+                initial.rot[node] = NodeRotation {
+                    w: b.angular_velocity,
+                    ..NodeRotation::REST
+                };
             }
+            None => elements.push(Element::PointMass(PointMass {
+                dofs: [d[0], d[1], d[2]],
+                mass: b.mass,
+                gravity: model.gravity,
+            })),
         }
     }
-    for b in &model.bodies {
-        length_scale = length_scale.max(b.position.iter().fold(0.0, |m: f64, x| m.max(x.abs())));
+    // Joints: element index of each, and whether each multiplier is a rate row.
+    let mut joint_element = Vec::new();
+    let mut rate_rows = vec![false; n];
+    for (ji, j) in model.joints.iter().enumerate() {
+        let lowered = joints::joint(&lw, ji, j);
+        for (r, row) in lowered.joint.rows.iter().enumerate() {
+            rate_rows[lowered.joint.first + r] = row.is_rate();
+        }
+        joint_element.push(elements.len());
+        elements.push(Element::Joint(lowered.joint));
+        elements.extend(lowered.forces.into_iter().map(Element::Spring));
+    }
+    for s in &model.springs {
+        entities.push(Entity {
+            name: s.name.clone(),
+            kind: "spring".to_string(),
+        });
+        spans.push(s.span);
+        elements.extend(joints::spring(&lw, s).into_iter().map(Element::Spring));
+    }
+    for l in &model.loads {
+        entities.push(Entity {
+            name: l.name.clone(),
+            kind: "load".to_string(),
+        });
+        spans.push(l.span);
+        elements.push(Element::Load(joints::load(&lw, l)));
+    }
+    let mut unknowns = Vec::with_capacity(n);
+    let mut owners = Vec::with_capacity(n);
+    for (i, u) in dofs.unknowns.iter().enumerate() {
+        let (kind, owner) = match *u {
+            Unknown::Translation { body, .. } => (UnknownKind::Coordinate, body),
+            Unknown::Rotation { body, axis } => match lw.node_of[body] {
+                Some(node) => (UnknownKind::Rotation { node, axis }, body),
+                None => (UnknownKind::Coordinate, body),
+            },
+            Unknown::JointAngle { joint } => (UnknownKind::Coordinate, nb + joint),
+            Unknown::Multiplier { joint, .. } => (
+                if rate_rows[i] {
+                    UnknownKind::RateMultiplier
+                } else {
+                    UnknownKind::Multiplier
+                },
+                nb + joint,
+            ),
+            Unknown::NodeTranslation { .. } | Unknown::NodeRotation { .. } => {
+                return Err(Diagnostic::error(
+                    Code::E0501,
+                    "internal: beam unknowns reached the lowering",
+                ))
+            }
+        };
+        unknowns.push(kind);
+        owners.push(owner);
     }
     let channels = model
         .outputs
         .iter()
-        .map(|o| {
-            let probe = match o.probe {
-                ModelProbe::Body {
-                    body,
-                    quantity,
-                    component,
-                } => {
-                    let index = body_dofs(body)[component];
-                    match quantity {
-                        BodyQuantity::Velocity => Probe::Velocity { index },
-                        BodyQuantity::Acceleration => Probe::Acceleration { index },
-                        _ => Probe::Position { index },
-                    }
-                }
-                ModelProbe::Joint {
-                    joint, quantity, ..
-                } => match quantity {
-                    JointQuantity::Force => Probe::ConstraintForce {
-                        element: nb + joint,
-                        row: 0,
-                    },
-                    _ => Probe::ConstraintViolation {
-                        element: nb + joint,
-                        row: 0,
-                    },
-                },
-                _ => Probe::Position { index: 0 },
-            };
-            Channel {
-                column: o.column.clone(),
-                probe,
-            }
+        .map(|o| Channel {
+            column: o.column.clone(),
+            probe: probe(&lw, &o.probe, &joint_element),
         })
         .collect();
     let system = System {
         unknowns,
         owners,
+        rotations,
+        translations,
         entities,
         elements,
         initial,
         channels,
-        length_scale: if length_scale > 0.0 {
-            length_scale
-        } else {
-            1.0
-        },
+        length_scale: length_scale(model),
     };
     Ok((system, Provenance { spans }))
+}
+
+/// The rigid body element: centre of mass and inertia about the reference point, in
+/// inertial components at t = 0 (THEORY §4).
+fn rigid(b: &Body, d: &[usize], node: usize, gravity: [f64; 3]) -> RigidBody {
+    let o = m3(&b.orientation);
+    let eta = o * V3::from(b.center);
+    let jc = o * m3(&b.inertia) * o.transpose();
+    let jref = jc + (M3::identity() * eta.norm_squared() - eta * eta.transpose()) * b.mass;
+    RigidBody {
+        dofs: [d[0], d[1], d[2], d[3], d[4], d[5]],
+        node,
+        mass: b.mass,
+        eta0: eta.into(),
+        inertia0: arr3(&jref),
+        gravity,
+    }
+}
+
+fn probe(lw: &Lower, p: &ModelProbe, joint_element: &[usize]) -> Probe {
+    let quantity = |q: BodyQuantity| match q {
+        BodyQuantity::Position => ProbeQuantity::Position,
+        BodyQuantity::Velocity => ProbeQuantity::Velocity,
+        BodyQuantity::Acceleration => ProbeQuantity::Acceleration,
+        BodyQuantity::AngularVelocity => ProbeQuantity::AngularVelocity,
+        BodyQuantity::AngularAcceleration => ProbeQuantity::AngularAcceleration,
+        BodyQuantity::Rotation => ProbeQuantity::Rotation,
+        BodyQuantity::Crv => ProbeQuantity::Crv,
+    };
+    match *p {
+        ModelProbe::Body {
+            body,
+            quantity: q,
+            component,
+        } => {
+            let b = &lw.model.bodies[body];
+            Probe::Point {
+                end: lw.end_at(
+                    &Attach::Body { body },
+                    V3::from(b.position),
+                    &m3(&b.orientation),
+                ),
+                quantity: quantity(q),
+                component,
+            }
+        }
+        ModelProbe::Point {
+            attach,
+            offset,
+            quantity: q,
+            component,
+        } => {
+            let (position, axes) = match attach {
+                Attach::Body { body } => {
+                    let b = &lw.model.bodies[body];
+                    let o = m3(&b.orientation);
+                    (V3::from(b.position) + o * V3::from(offset), o)
+                }
+                _ => (V3::from(offset), M3::identity()),
+            };
+            Probe::Point {
+                end: lw.end_at(&attach, position, &axes),
+                quantity: quantity(q),
+                component,
+            }
+        }
+        ModelProbe::Joint {
+            joint,
+            quantity: q,
+            component,
+        } => {
+            let element = joint_element[joint];
+            match q {
+                JointQuantity::Force => Probe::JointForce { element, component },
+                JointQuantity::Moment => Probe::JointMoment {
+                    element,
+                    component: component.unwrap_or(0),
+                },
+                JointQuantity::Angle => Probe::JointAngle { element },
+                JointQuantity::Rate => Probe::JointRate { element },
+                JointQuantity::Violation => Probe::Violation { element },
+            }
+        }
+        ModelProbe::Energy { kind } => Probe::Energy {
+            kind: match kind {
+                ModelEnergy::Kinetic => EnergyKind::Kinetic,
+                ModelEnergy::Potential => EnergyKind::Potential,
+                ModelEnergy::Total => EnergyKind::Total,
+            },
+        },
+    }
+}
+
+/// A length typical of the model: the largest distance of a body or marker from the origin
+/// or of a joint's markers from each other, at least 1 mm.
+fn length_scale(model: &Model) -> f64 {
+    let norm = |x: [f64; 3]| V3::from(x).norm();
+    let mut l: f64 = 1e-3;
+    for b in &model.bodies {
+        l = l.max(norm(b.position));
+        for (_, offset, _) in &b.markers {
+            l = l.max(norm(*offset));
+        }
+    }
+    for j in &model.joints {
+        for m in &j.markers {
+            l = l.max(norm(m.position));
+        }
+    }
+    l
 }

@@ -57,6 +57,8 @@ pub struct Overrides {
     pub sets: Vec<(crate::syntax::ast::Ident, crate::syntax::ast::Expr)>,
     pub integrator: Option<Integrator>,
     pub alpha: Option<f64>,
+    pub rho_inf: Option<f64>,
+    pub rotations: Option<Rotations>,
     pub dt: Option<f64>,
     pub steps: Option<usize>,
     pub until: Option<f64>,
@@ -245,12 +247,12 @@ pub enum JointKind {
 }
 
 impl JointKind {
-    /// The number of constraint equations (multipliers).
+    /// The number of constraint equations (multipliers). A revolute joint has six: three for
+    /// the point, two for the axis, and one tying its angle unknown to the measured angle.
     pub fn multipliers(&self) -> usize {
         match self {
-            JointKind::Revolute { drive, .. } | JointKind::Prismatic { drive, .. } => {
-                5 + usize::from(!matches!(drive, Drive::Free))
-            }
+            JointKind::Revolute { drive, .. } => 6 + usize::from(!matches!(drive, Drive::Free)),
+            JointKind::Prismatic { drive, .. } => 5 + usize::from(!matches!(drive, Drive::Free)),
             JointKind::Cylindrical { .. } => 4,
             JointKind::Universal { .. } => 4,
             JointKind::Spherical => 3,
@@ -400,7 +402,19 @@ pub struct OutputChannel {
 #[serde(rename_all = "snake_case")]
 pub enum Integrator {
     Hht,
+    /// Generalized-alpha (Arnold-Bruls form).
+    GeneralizedAlpha,
     Fet,
+}
+
+/// How rotations are integrated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Rotations {
+    /// Stored rotation matrices updated by incremental rotations (default).
+    Incremental,
+    /// The paper's total conformal rotation vector, rescaled past pi.
+    Conformal,
 }
 
 /// How the first step starts.
@@ -418,6 +432,9 @@ pub struct SolveSpec {
     pub integrator: Integrator,
     /// HHT alpha in [-1/3, 0].
     pub alpha: f64,
+    /// Generalized-alpha spectral radius at infinity, in [0, 1].
+    pub rho_inf: f64,
+    pub rotations: Rotations,
     pub dt: f64,
     pub steps: usize,
     pub until: f64,

@@ -42,11 +42,12 @@ impl Builder<'_> {
         if let Some(m) = method {
             integrator = match m.name.as_str() {
                 "hht" => Integrator::Hht,
+                "generalized_alpha" => Integrator::GeneralizedAlpha,
                 "fet" => Integrator::Fet,
                 other => {
-                    let hint = match did_you_mean(other, ["hht", "fet"]) {
-                        Some(s) => format!("did you mean `{s}`? Solvers: hht, fet"),
-                        None => "solvers: hht (HHT-alpha), fet (time finite elements)".to_string(),
+                    let hint = match did_you_mean(other, ["hht", "generalized_alpha", "fet"]) {
+                        Some(s) => format!("did you mean `{s}`? Solvers: hht, generalized_alpha, fet"),
+                        None => "solvers: hht (HHT-alpha), generalized_alpha, fet (time finite elements)".to_string(),
                     };
                     self.error(
                         top,
@@ -68,6 +69,8 @@ impl Builder<'_> {
             Some(&block),
             &[
                 "alpha",
+                "rho_inf",
+                "rotations",
                 "dt",
                 "steps",
                 "until",
@@ -88,6 +91,27 @@ impl Builder<'_> {
                 return None;
             }
         }
+        let mut rho_inf = match self.expr(top, p.get("rho_inf")) {
+            Some(r) => self.scalar(top, r, Dim::NONE, "`rho_inf`")?,
+            None => 0.8,
+        };
+        if let Some(crate::syntax::ast::PropValue::Expr(r)) = p.get("rho_inf").map(|p| &p.value) {
+            if !(0.0..=1.0).contains(&rho_inf) {
+                self.error(top, Diagnostic::error(Code::E0213, format!("rho_inf = {rho_inf} is outside [0, 1]")).at(r.span, "out of range").hint("rho_inf is the spectral radius at infinite frequency: 1 adds no dissipation, 0 the most; 0.8 is usual"));
+                return None;
+            }
+        }
+        let mut rotations = match self.expr(top, p.get("rotations")) {
+            Some(s) => match &s.kind {
+                ExprKind::Path { path } if path.text() == "incremental" => Rotations::Incremental,
+                ExprKind::Path { path } if path.text() == "conformal" => Rotations::Conformal,
+                _ => {
+                    self.error(top, Diagnostic::error(Code::E0211, "unknown rotation treatment").at(s.span, "not a rotation treatment").hint("`rotations = incremental` (default: stored rotations, incremental parameters) or `rotations = conformal` (the paper's total conformal rotation vector, rescaled past pi)"));
+                    return None;
+                }
+            },
+            None => Rotations::Incremental,
+        };
         let mut dt = match self.expr(top, p.get("dt")) {
             Some(d) => Some((self.scalar(top, d, Dim::TIME, "`dt`")?, d.span)),
             None => None,
@@ -153,6 +177,8 @@ impl Builder<'_> {
         // Command-line flags override the block.
         integrator = o.integrator.unwrap_or(integrator);
         alpha = o.alpha.unwrap_or(alpha);
+        rho_inf = o.rho_inf.unwrap_or(rho_inf);
+        rotations = o.rotations.unwrap_or(rotations);
         if let Some(d) = o.dt {
             dt = Some((d, span));
             steps = None;
@@ -185,6 +211,8 @@ impl Builder<'_> {
         Some(SolveSpec {
             integrator,
             alpha,
+            rho_inf,
+            rotations,
             dt,
             steps,
             until,

@@ -34,7 +34,7 @@ impl<W: Write> CsvWriter<W> {
         // `+ 0.0` turns a negative zero into zero.
         let _ = write!(self.line, "{:?}", st.t + 0.0);
         for c in &sys.channels {
-            let _ = write!(self.line, ",{:?}", sys.probe(c.probe, st, aug) + 0.0);
+            let _ = write!(self.line, ",{:?}", sys.probe(&c.probe, st, aug) + 0.0);
         }
         self.line.push('\n');
         self.out.write_all(self.line.as_bytes())

@@ -3,22 +3,50 @@
 //! Contract: elements compute residuals and tangents from a state and coefficients that the
 //! integrator supplies; the runtime is integrator-agnostic. It knows entity names (for
 //! messages) but nothing of spans or files, and it never touches faer.
+//!
+//! Rotations: every rotating node keeps its rotation matrix `R`, angular velocity `omega` and
+//! angular acceleration `omega-dot` (inertial components) in [`State::rot`]. Elements read
+//! rotations only from there and give forces conjugate to virtual rotations `delta theta`
+//! (`R <- exp(delta theta~) R`), so the same element code serves every rotation treatment of
+//! the integrator (THEORY §1, §7.1).
 
 mod assembly;
+mod bodies;
 mod elements;
+mod forces;
+mod joints;
+mod probes;
+pub mod rotation;
 pub mod timefn;
 
 pub use assembly::{Assembler, Pattern};
-pub use elements::{Anchor, Element, Rate};
+pub use bodies::{PointMass, RigidBody};
+pub use elements::Element;
+pub use forces::{Load, LoadKind, Spring, SpringKind};
+pub use joints::{End, EndKin, Joint, Row};
+pub use probes::{EnergyKind, Probe, ProbeQuantity};
 
+use rotation::{M3, V3};
 use serde::{Deserialize, Serialize};
 
-/// What an unknown is: a coordinate with inertia and Newmark relations, or a multiplier.
+/// What an unknown is.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum UnknownKind {
+    /// A translation or a joint scalar: Newmark relations on `q`, `v`, `a`.
     Coordinate,
+    /// Component `axis` of the rotation of rotating node `node`.
+    Rotation { node: usize, axis: usize },
+    /// A position-level constraint's multiplier.
     Multiplier,
+    /// A velocity-level constraint's multiplier (a prescribed rate).
+    RateMultiplier,
+}
+
+impl UnknownKind {
+    pub fn is_multiplier(self) -> bool {
+        matches!(self, UnknownKind::Multiplier | UnknownKind::RateMultiplier)
+    }
 }
 
 /// A named thing of the model (body or joint), for runtime messages.
@@ -26,30 +54,6 @@ pub enum UnknownKind {
 pub struct Entity {
     pub name: String,
     pub kind: String,
-}
-
-/// A quantity written to the output.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(tag = "probe", rename_all = "snake_case")]
-pub enum Probe {
-    Position {
-        index: usize,
-    },
-    Velocity {
-        index: usize,
-    },
-    Acceleration {
-        index: usize,
-    },
-    /// The physical constraint force `mu = s*lambda + p*C` of a multiplier.
-    ConstraintForce {
-        element: usize,
-        row: usize,
-    },
-    ConstraintViolation {
-        element: usize,
-        row: usize,
-    },
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -64,6 +68,10 @@ pub struct System {
     pub unknowns: Vec<UnknownKind>,
     /// The entity each unknown belongs to.
     pub owners: Vec<usize>,
+    /// The first of the three rotation unknowns of each rotating node.
+    pub rotations: Vec<usize>,
+    /// The first of the three translation unknowns of each rotating node (its position).
+    pub translations: Vec<usize>,
     pub entities: Vec<Entity>,
     pub elements: Vec<Element>,
     pub initial: State,
@@ -87,6 +95,7 @@ impl System {
             .elements
             .iter()
             .filter_map(|e| e.translational_mass())
+            .filter(|m| *m > 0.0)
             .collect();
         if masses.is_empty() {
             1.0
@@ -99,25 +108,53 @@ impl System {
     pub fn mean_stiffness(&self) -> f64 {
         0.0
     }
+}
 
-    /// The value of a probe in a state (scaling `s`, `p` to form physical constraint forces).
-    pub fn probe(&self, probe: Probe, st: &State, aug: Augment) -> f64 {
-        match probe {
-            Probe::Position { index } => st.q[index],
-            Probe::Velocity { index } => st.v[index],
-            Probe::Acceleration { index } => st.a[index],
-            Probe::ConstraintForce { element, row } => {
-                self.elements[element].constraint_force(st, aug, row)
-            }
-            Probe::ConstraintViolation { element, row } => {
-                self.elements[element].violation(st, row)
+/// Kinematics of one rotating node: rotation from its initial orientation, angular velocity
+/// and angular acceleration (inertial components).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct NodeRotation {
+    pub r: [[f64; 3]; 3],
+    pub w: [f64; 3],
+    pub dw: [f64; 3],
+}
+
+impl NodeRotation {
+    pub const REST: NodeRotation = NodeRotation {
+        r: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
+        w: [0.0; 3],
+        dw: [0.0; 3],
+    };
+
+    #[inline]
+    pub fn matrix(&self) -> M3 {
+        M3::from_fn(|i, j| self.r[i][j])
+    }
+
+    #[inline]
+    pub fn set_matrix(&mut self, m: &M3) {
+        for i in 0..3 {
+            for j in 0..3 {
+                self.r[i][j] = m[(i, j)];
             }
         }
     }
+
+    #[inline]
+    pub fn omega(&self) -> V3 {
+        V3::from(self.w)
+    }
+
+    #[inline]
+    pub fn omega_dot(&self) -> V3 {
+        V3::from(self.dw)
+    }
 }
 
-/// The state at one instant. All vectors have one entry per unknown; multiplier entries of
-/// `q`, `v`, `a` are unused, and `lambda` is used only at multipliers.
+/// The state at one instant. `q`, `v`, `a` have one entry per unknown: positions, velocities
+/// and accelerations of coordinates; for rotation unknowns, whatever the integrator's
+/// rotation treatment keeps there (the rotating nodes' kinematics are in `rot`). `lambda`
+/// is used only at multipliers. `alg` holds generalized-alpha's algorithmic accelerations.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct State {
     pub t: f64,
@@ -125,16 +162,32 @@ pub struct State {
     pub v: Vec<f64>,
     pub a: Vec<f64>,
     pub lambda: Vec<f64>,
+    pub alg: Vec<f64>,
+    pub rot: Vec<NodeRotation>,
+    /// Body-frame velocities of the rotating nodes (incremental treatment).
+    pub frames: Vec<Frame>,
+}
+
+/// A rotating node's body-frame twist `(R^T x-dot, R^T omega)`, its rate and the integrator's
+/// algorithmic rate: what the SE(3) Newmark relations act on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Frame {
+    pub v: [f64; 6],
+    pub dv: [f64; 6],
+    pub alg: [f64; 6],
 }
 
 impl State {
-    pub fn zeros(n: usize) -> State {
+    pub fn zeros(n: usize, nodes: usize) -> State {
         State {
             t: 0.0,
             q: vec![0.0; n],
             v: vec![0.0; n],
             a: vec![0.0; n],
             lambda: vec![0.0; n],
+            alg: vec![0.0; n],
+            rot: vec![NodeRotation::REST; nodes],
+            frames: vec![Frame::default(); nodes],
         }
     }
 
@@ -147,25 +200,48 @@ impl State {
                 && self.lambda[i].is_finite())
         })
     }
+
+    /// The first rotating node with a non-finite rotation, rate or acceleration.
+    pub fn first_non_finite_node(&self) -> Option<usize> {
+        self.rot.iter().position(|n| {
+            !(n.r.iter().flatten().all(|x| x.is_finite())
+                && n.w.iter().all(|x| x.is_finite())
+                && n.dw.iter().all(|x| x.is_finite()))
+        })
+    }
 }
 
-/// Augmented-Lagrangian scaling `s` and penalty `p` (THEORY §6).
+/// Augmented-Lagrangian scaling `s`, penalty `p` (THEORY §6), and the time scale that turns a
+/// velocity-level constraint row into a position-like one (`1 / (d v / d q)` of the
+/// integrator, `beta h / gamma` for Newmark).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Augment {
     pub s: f64,
     pub p: f64,
+    pub rate_scale: f64,
 }
 
-/// Coefficients the integrator supplies to combine the element matrices:
-/// `mass * M + velocity * G + position * K_inertia + force_weight * (position * K + velocity * D)`,
-/// with the constraint coupling column weighted by `force_weight` and the constraint rows
-/// always `s * B`.
+/// Coefficients the integrator supplies to combine the element matrices: the derivatives of
+/// the accelerations (`mass`) and velocities (`velocity`) with respect to the positions, the
+/// weight of the configuration-dependent inertial terms (`position`), and the weight of the
+/// forces `F^int + F^c - F^ext` (`force_weight`, `1 + alpha` for HHT). The iteration matrix is
+/// `mass M + velocity G + position K^I + force_weight (position K + velocity D)`, with the
+/// constraint coupling column weighted by `force_weight` and the constraint rows `s B`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct TangentCoeffs {
     pub mass: f64,
     pub velocity: f64,
     pub position: f64,
     pub force_weight: f64,
+}
+
+/// Which time derivative of the constraints to evaluate.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rate {
+    /// `B v + dC/dt`: the velocity constraint (for rate rows, their value).
+    Velocity,
+    /// `dB/dt v + d2C/dt2`: with `B a`, the second time derivative of `C`.
+    AccelerationBias,
 }
 
 /// Residual parts, each one entry per unknown.
@@ -175,7 +251,7 @@ pub struct Residual {
     pub inertia: Vec<f64>,
     /// `F^int + F^c - F^ext`.
     pub force: Vec<f64>,
-    /// Constraint values `C` (or their rates) at multiplier rows.
+    /// Constraint values `C` at multiplier rows (rate rows: `rate_scale` times their value).
     pub constraint: Vec<f64>,
 }
 
@@ -193,4 +269,28 @@ impl Residual {
         self.force.iter_mut().for_each(|x| *x = 0.0);
         self.constraint.iter_mut().for_each(|x| *x = 0.0);
     }
+}
+
+/// Mechanical energies of a state.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Energy {
+    pub kinetic: f64,
+    pub potential: f64,
+}
+
+/// A 3x3 matrix stored as rows, as in the IR.
+#[inline]
+pub fn m3(a: &[[f64; 3]; 3]) -> M3 {
+    M3::from_fn(|i, j| a[i][j])
+}
+
+#[inline]
+pub fn arr3(m: &M3) -> [[f64; 3]; 3] {
+    let mut a = [[0.0; 3]; 3];
+    for (i, row) in a.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = m[(i, j)];
+        }
+    }
+    a
 }

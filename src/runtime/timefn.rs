@@ -4,9 +4,9 @@
 //! `sine`, `constant` and arithmetic on `t`. Evaluated with their first two time derivatives
 //! (forward-mode jets), because a prescribed angle needs its rate and acceleration too.
 
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Unary {
     Sin,
@@ -21,7 +21,7 @@ pub enum Unary {
     Ln,
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Binary {
     Add,
@@ -34,7 +34,7 @@ pub enum Binary {
 }
 
 /// What a piecewise-linear function does outside its first and last knot.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Outside {
     /// Constant: the first (last) knot's value.
@@ -45,7 +45,7 @@ pub enum Outside {
     Periodic,
 }
 
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "f", rename_all = "snake_case")]
 pub enum TimeFn {
     Const {

@@ -1,20 +1,27 @@
-//! Solve: System -> trajectory. Newton, HHT-alpha, sparse LU reuse.
+//! Solve: System -> trajectory. Newton, HHT-alpha and generalized-alpha, sparse LU reuse.
 //!
 //! Contract: drives the runtime through its generic interface (residual parts, tangent with
-//! coefficients, constraint rates); knows no concrete element type and no spans. Failures are
-//! typed [`RuntimeFailure`]s naming the time, the step and the entity with the largest residual.
+//! coefficients, constraint rates, rotating nodes); knows no concrete element type and no
+//! spans. Failures are typed [`RuntimeFailure`]s naming the time, the step and the entity with
+//! the largest residual.
 
-mod hht;
+mod integrator;
 pub mod linear;
+mod rotations;
+mod se3;
 
-pub use hht::Hht;
+pub use integrator::Integrator;
 
 use serde::Serialize;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Method {
+    /// HHT-alpha (THEORY §7.2).
     Hht,
+    /// Generalized-alpha, Arnold-Bruls form (THEORY §7.5).
+    GeneralizedAlpha,
+    /// Time finite elements (not available yet).
     Fet,
 }
 
@@ -27,6 +34,18 @@ pub enum StartMode {
     ZeroAcceleration,
 }
 
+/// How rotations are integrated (THEORY §2.7, §7.1).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RotationTreatment {
+    /// A stored rotation matrix updated by incremental rotations; Newmark on the rotation
+    /// increment, angular velocity and acceleration. Never rescales.
+    Incremental,
+    /// The paper's: the total conformal rotation vector is the unknown, Newmark on `c`,
+    /// `c-dot`, `c-ddot`, with the change of state when `|c| > 4`.
+    Conformal,
+}
+
 /// Solver settings. Every field: default, range, effect.
 #[derive(Clone, Debug, Serialize)]
 pub struct Settings {
@@ -35,6 +54,10 @@ pub struct Settings {
     /// HHT alpha, in [-1/3, 0]. Default -0.1. More negative damps high frequencies more
     /// (spectral radius at infinity (1+alpha)/(1-alpha)); 0 is the trapezoidal rule.
     pub alpha: f64,
+    /// Generalized-alpha spectral radius at infinity, in [0, 1]. Default 0.8.
+    pub rho_inf: f64,
+    /// Rotation treatment. Default incremental.
+    pub rotation: RotationTreatment,
     /// Time step [s], > 0. Default from the model's `solve` block.
     pub dt: f64,
     /// Number of steps, >= 1; the run ends at `steps * dt`.
@@ -43,14 +66,14 @@ pub struct Settings {
     pub every: usize,
     /// How to start. Default consistent.
     pub start: StartMode,
-    /// Newton increment tolerance relative to the model's length scale, in (0, 1e-2).
-    /// Default 1e-10; also bounds the constraint violation (times the length scale).
+    /// Newton increment tolerance relative to the model's length scale (and in radians for
+    /// rotations), in (0, 1e-2). Default 1e-10; also bounds the constraint violation.
     pub increment_tolerance: f64,
     /// Residual tolerance relative to the largest force of the step. Default 1e-8.
     pub residual_tolerance: f64,
     /// Newton iterations per step before the step is halved. Default 25.
     pub max_iterations: usize,
-    /// How many times a failing step is halved before the run fails. Default 3.
+    /// How many times a failing step is halved before the run fails. Default 1.
     pub max_halvings: usize,
 }
 
@@ -99,6 +122,8 @@ pub struct RunStats {
     pub steps: usize,
     pub newton_iterations: usize,
     pub halvings: usize,
+    /// Changes of state of conformal rotation vectors (conformal treatment only).
+    pub rescalings: usize,
     /// Largest |C| over all steps [m].
     pub max_constraint_violation: f64,
 }

@@ -1,0 +1,162 @@
+//! Point masses and rigid bodies (THEORY §4).
+//!
+//! A rigid body is one node: the translation `x` of its reference point and its rotation `R`
+//! from the initial orientation. Its centre of mass is at `eta = R eta0` from the node and its
+//! inertia about the node is `J = R J0 R^T`, with `eta0` and `J0` in inertial components at
+//! t = 0. Inertial forces (inertial components):
+//! `F_u = m a + (dw~ + w~ w~) m eta`, `F_theta = m eta~ a + J dw + w~ J w`.
+
+use super::rotation::{tilde, M3, V3};
+use super::{m3, Energy, Residual, State, TangentCoeffs};
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointMass {
+    pub dofs: [usize; 3],
+    pub mass: f64,
+    pub gravity: [f64; 3],
+}
+
+impl PointMass {
+    pub fn residual(&self, st: &State, r: &mut Residual) {
+        for k in 0..3 {
+            r.inertia[self.dofs[k]] += self.mass * st.a[self.dofs[k]];
+            r.force[self.dofs[k]] -= self.mass * self.gravity[k];
+        }
+    }
+
+    pub fn tangent(&self, c: TangentCoeffs, k: &mut [f64]) {
+        k[..9].iter_mut().for_each(|x| *x = 0.0);
+        for i in 0..3 {
+            k[i * 3 + i] = c.mass * self.mass;
+        }
+    }
+
+    pub fn energy(&self, st: &State) -> Energy {
+        let v = V3::from(self.dofs.map(|i| st.v[i]));
+        let x = V3::from(self.dofs.map(|i| st.q[i]));
+        Energy {
+            kinetic: 0.5 * self.mass * v.norm_squared(),
+            potential: -self.mass * V3::from(self.gravity).dot(&x),
+        }
+    }
+}
+
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RigidBody {
+    /// Translation unknowns of the reference point, then rotation unknowns.
+    pub dofs: [usize; 6],
+    /// The rotating node.
+    pub node: usize,
+    pub mass: f64,
+    /// Centre of mass from the reference point, inertial components at t = 0.
+    pub eta0: [f64; 3],
+    /// Inertia tensor about the reference point, inertial components at t = 0.
+    pub inertia0: [[f64; 3]; 3],
+    pub gravity: [f64; 3],
+}
+
+/// The body's configuration-dependent quantities at a state.
+struct Kin {
+    a: V3,
+    w: V3,
+    dw: V3,
+    /// `m eta` (inertial).
+    meta: V3,
+    j: M3,
+}
+
+impl RigidBody {
+    fn kin(&self, st: &State) -> Kin {
+        let n = &st.rot[self.node];
+        let r = n.matrix();
+        Kin {
+            a: V3::new(st.a[self.dofs[0]], st.a[self.dofs[1]], st.a[self.dofs[2]]),
+            w: n.omega(),
+            dw: n.omega_dot(),
+            meta: r * V3::from(self.eta0) * self.mass,
+            j: r * m3(&self.inertia0) * r.transpose(),
+        }
+    }
+
+    pub fn residual(&self, st: &State, r: &mut Residual) {
+        let k = self.kin(st);
+        let (wt, dwt) = (tilde(&k.w), tilde(&k.dw));
+        let g = V3::from(self.gravity);
+        let fu = self.mass * k.a + (dwt + wt * wt) * k.meta;
+        let ft = k.meta.cross(&k.a) + k.j * k.dw + k.w.cross(&(k.j * k.w));
+        let gt = k.meta.cross(&g);
+        for i in 0..3 {
+            r.inertia[self.dofs[i]] += fu[i];
+            r.inertia[self.dofs[3 + i]] += ft[i];
+            r.force[self.dofs[i]] -= self.mass * g[i];
+            r.force[self.dofs[3 + i]] -= gt[i];
+        }
+    }
+
+    /// `mass M + velocity G + position K^I + force_weight position K^grav` (THEORY §3.6, §4).
+    pub fn tangent(&self, st: &State, c: TangentCoeffs, k: &mut [f64]) {
+        let kin = self.kin(st);
+        let (wt, dwt, at) = (tilde(&kin.w), tilde(&kin.dw), tilde(&kin.a));
+        let et = tilde(&kin.meta);
+        let jw = kin.j * kin.w;
+        let jdw = kin.j * kin.dw;
+        let g = V3::from(self.gravity);
+        // Mass.
+        let m_uu = M3::identity() * self.mass;
+        let m_ut = et.transpose();
+        let m_tu = et;
+        let m_tt = kin.j;
+        // Gyroscopic: d F^I / d(v, w).
+        let g_ut = tilde(&(wt * kin.meta)).transpose() + wt * et.transpose();
+        let g_tt = wt * kin.j - tilde(&jw);
+        // Configuration: d F^I / d theta at fixed (a, dw) and (v, w); gravity moment.
+        let k_ut = (dwt + wt * wt) * et.transpose();
+        let k_tt = at * et + kin.j * dwt - tilde(&jdw) + wt * kin.j * wt - wt * tilde(&jw);
+        let k_grav = -tilde(&g) * et;
+        let blocks = [
+            (0, 0, m_uu * c.mass),
+            (0, 3, m_ut * c.mass + g_ut * c.velocity + k_ut * c.position),
+            (3, 0, m_tu * c.mass),
+            (
+                3,
+                3,
+                m_tt * c.mass
+                    + g_tt * c.velocity
+                    + k_tt * c.position
+                    + k_grav * (c.position * c.force_weight),
+            ),
+        ];
+        k[..36].iter_mut().for_each(|x| *x = 0.0);
+        for (r0, c0, b) in blocks {
+            add_block(k, 6, r0, c0, &b);
+        }
+    }
+
+    pub fn energy(&self, st: &State) -> Energy {
+        let n = &st.rot[self.node];
+        let r = n.matrix();
+        let w = n.omega();
+        let v = V3::new(st.v[self.dofs[0]], st.v[self.dofs[1]], st.v[self.dofs[2]]);
+        let x = V3::new(st.q[self.dofs[0]], st.q[self.dofs[1]], st.q[self.dofs[2]]);
+        let meta = r * V3::from(self.eta0) * self.mass;
+        let j = r * m3(&self.inertia0) * r.transpose();
+        // T = 1/2 m v.v + v.(w x m eta) + 1/2 w.J w (about the reference point).
+        Energy {
+            kinetic: 0.5 * self.mass * v.norm_squared()
+                + v.dot(&w.cross(&meta))
+                + 0.5 * w.dot(&(j * w)),
+            potential: -V3::from(self.gravity).dot(&(self.mass * x + meta)),
+        }
+    }
+}
+
+/// Adds a 3x3 block at `(r0, c0)` of a row-major `nl`-column matrix.
+#[inline]
+pub(crate) fn add_block(k: &mut [f64], nl: usize, r0: usize, c0: usize, b: &M3) {
+    for i in 0..3 {
+        for j in 0..3 {
+            k[(r0 + i) * nl + c0 + j] += b[(i, j)];
+        }
+    }
+}

@@ -1,0 +1,280 @@
+//! Every element's analytic tangent against central differences of its residual, at random
+//! states, with random integrator coefficients (THEORY §3.6: the finite-difference oracle).
+//!
+//! A perturbation `eps` of unknown `j` moves the state the way a Newton correction does
+//! through the integrator's relations: positions by `eps * position` (rotations by
+//! `R <- exp(eps * position * e_j~) R`), velocities by `eps * velocity`, accelerations by
+//! `eps * mass`; multipliers by `eps`. The residual is the integrator's:
+//! `F^I + force_weight * F` at coordinates and `s * C` at multipliers.
+
+use super::*;
+use crate::runtime::forces::LoadKind;
+use crate::runtime::joints::{End, Row};
+use crate::runtime::rotation::{exp, V3};
+use crate::runtime::timefn::{Binary, TimeFn, Unary};
+use crate::runtime::{NodeRotation, SpringKind};
+
+/// A small deterministic generator.
+struct Lcg(u64);
+
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        ((self.0 >> 11) as f64 / (1u64 << 53) as f64) * 2.0 - 1.0
+    }
+
+    fn v3(&mut self) -> [f64; 3] {
+        [self.next(), self.next(), self.next()]
+    }
+
+    fn rotation(&mut self, size: f64) -> [[f64; 3]; 3] {
+        crate::runtime::arr3(&exp(&(V3::from(self.v3()) * size)))
+    }
+}
+
+/// Layout of the test system: node A (unknowns 0..6, rotating node 0), node B (6..12,
+/// node 1), a joint angle (12), multipliers from 13.
+const N: usize = 40;
+const ROT_A: [usize; 3] = [3, 4, 5];
+const ROT_B: [usize; 3] = [9, 10, 11];
+
+fn random_state(rng: &mut Lcg) -> State {
+    let mut st = State::zeros(N, 2);
+    st.t = 0.3 + rng.next().abs();
+    for i in 0..N {
+        st.q[i] = rng.next();
+        st.v[i] = rng.next();
+        st.a[i] = rng.next();
+        st.lambda[i] = rng.next();
+    }
+    for k in 0..2 {
+        st.rot[k] = NodeRotation {
+            r: rng.rotation(2.0),
+            w: rng.v3(),
+            dw: rng.v3(),
+        };
+    }
+    st
+}
+
+fn node_end(rng: &mut Lcg, which: usize) -> End {
+    let s = 6 * which;
+    End::Node {
+        dofs: [s, s + 1, s + 2, s + 3, s + 4, s + 5],
+        node: which,
+        offset: rng.v3(),
+        axes: rng.rotation(3.0),
+    }
+}
+
+fn ends(rng: &mut Lcg, case: usize) -> (End, End) {
+    let b = node_end(rng, 1);
+    let a = match case % 3 {
+        0 => node_end(rng, 0),
+        1 => End::Point {
+            dofs: [0, 1, 2],
+            axes: rng.rotation(3.0),
+        },
+        _ => End::Ground {
+            point: rng.v3(),
+            axes: rng.rotation(3.0),
+        },
+    };
+    (a, b)
+}
+
+/// `sin(2 t) + t^2`: a drive with non-trivial derivatives.
+fn drive() -> TimeFn {
+    TimeFn::binary(
+        Binary::Add,
+        TimeFn::Unary {
+            op: Unary::Sin,
+            arg: Box::new(TimeFn::binary(
+                Binary::Mul,
+                TimeFn::constant(2.0),
+                TimeFn::Time,
+            )),
+        },
+        TimeFn::binary(Binary::Mul, TimeFn::Time, TimeFn::Time),
+    )
+}
+
+fn all_rows() -> Vec<Row> {
+    vec![
+        Row::Point { k: 0 },
+        Row::Point { k: 1 },
+        Row::Point { k: 2 },
+        Row::Dot { i: 1, j: 2 },
+        Row::Dot { i: 2, j: 0 },
+        Row::Dot { i: 0, j: 1 },
+        Row::Along { i: 0, offset: 0.1 },
+        Row::Along { i: 2, offset: -0.2 },
+        Row::Angle,
+        Row::Distance { length: 0.7 },
+        Row::AngleDrive { f: drive() },
+        Row::AngleRate { f: drive() },
+        Row::SlideDrive {
+            offset: 0.3,
+            f: drive(),
+        },
+        Row::SlideRate { f: drive() },
+        Row::Phi,
+    ]
+}
+
+/// The test elements for one random case.
+fn elements(rng: &mut Lcg, case: usize) -> Vec<Element> {
+    let (a, b) = ends(rng, case);
+    let mut out = vec![
+        Element::RigidBody(RigidBody {
+            dofs: [6, 7, 8, 9, 10, 11],
+            node: 1,
+            mass: 1.0 + rng.next().abs(),
+            eta0: rng.v3(),
+            inertia0: {
+                let r = crate::runtime::m3(&rng.rotation(3.0));
+                let d = crate::runtime::rotation::M3::from_diagonal(&V3::new(
+                    1.0 + rng.next().abs(),
+                    1.0 + rng.next().abs(),
+                    1.5 + rng.next().abs(),
+                ));
+                crate::runtime::arr3(&(r * d * r.transpose()))
+            },
+            gravity: rng.v3(),
+        }),
+        Element::Joint(Joint {
+            a: a.clone(),
+            b: b.clone(),
+            angle: Some(12),
+            first: 13,
+            rows: all_rows(),
+            slide_offset: Some(0.3),
+        }),
+        Element::Spring(Spring {
+            kind: SpringKind::Torsional,
+            a: a.clone(),
+            b: b.clone(),
+            angle: None,
+            row: Row::Phi,
+            stiffness: 2.0,
+            damping: 0.5,
+            rest: 0.0,
+            load: None,
+        }),
+    ];
+    for row in [
+        Row::Distance { length: 0.4 },
+        Row::Along { i: 2, offset: 0.1 },
+        Row::Point { k: 1 },
+        Row::Phi,
+    ] {
+        out.push(Element::Spring(Spring {
+            kind: SpringKind::Row,
+            a: a.clone(),
+            b: b.clone(),
+            angle: Some(12),
+            row,
+            stiffness: 3.0,
+            damping: 0.7,
+            rest: 0.2,
+            load: Some(drive()),
+        }));
+    }
+    for (kind, follower) in [
+        (LoadKind::Force, false),
+        (LoadKind::Force, true),
+        (LoadKind::Torque, false),
+        (LoadKind::Torque, true),
+    ] {
+        out.push(Element::Load(Load {
+            kind,
+            end: b.clone(),
+            value: [drive(), TimeFn::constant(0.5), TimeFn::Time],
+            follower,
+        }));
+    }
+    out
+}
+
+fn perturb(st: &State, j: usize, eps: f64, c: TangentCoeffs) -> State {
+    let mut s = st.clone();
+    if j >= 13 {
+        s.lambda[j] += eps;
+        return s;
+    }
+    for (node, rot) in [(0usize, ROT_A), (1, ROT_B)] {
+        if let Some(axis) = rot.iter().position(|&r| r == j) {
+            let mut e = V3::zeros();
+            e[axis] = eps * c.position;
+            let r = exp(&e) * s.rot[node].matrix();
+            s.rot[node].set_matrix(&r);
+            s.rot[node].w[axis] += eps * c.velocity;
+            s.rot[node].dw[axis] += eps * c.mass;
+            return s;
+        }
+    }
+    s.q[j] += eps * c.position;
+    s.v[j] += eps * c.velocity;
+    s.a[j] += eps * c.mass;
+    s
+}
+
+#[test]
+fn tangents_match_central_differences() {
+    let mut rng = Lcg(7);
+    let rate_rows: Vec<bool> = all_rows().iter().map(Row::is_rate).collect();
+    for case in 0..60 {
+        let c = TangentCoeffs {
+            mass: 1.0 + 5.0 * rng.next().abs(),
+            velocity: 0.5 + 2.0 * rng.next().abs(),
+            // Newton's unknowns are the positions: the constraint rows are `s B` for a unit
+            // position weight (TangentCoeffs).
+            position: 1.0,
+            force_weight: 0.8 + 0.2 * rng.next().abs(),
+        };
+        let aug = Augment {
+            s: 1.0 + 3.0 * rng.next().abs(),
+            p: 1.0 + 3.0 * rng.next().abs(),
+            rate_scale: 1.0 / c.velocity,
+        };
+        let st = random_state(&mut rng);
+        for (ei, el) in elements(&mut rng, case).iter().enumerate() {
+            let idx = el.indices();
+            let nl = idx.len();
+            let mut k = vec![0.0; nl * nl];
+            el.tangent(&st, aug, c, &mut k);
+            let full = |s: &State| {
+                let mut r = Residual::new(N);
+                el.residual(s, aug, &mut r);
+                (0..N)
+                    .map(|i| {
+                        if i >= 13 {
+                            aug.s * r.constraint[i]
+                        } else {
+                            r.inertia[i] + c.force_weight * r.force[i]
+                        }
+                    })
+                    .collect::<Vec<f64>>()
+            };
+            let h = 1e-6;
+            for (lj, &j) in idx.iter().enumerate() {
+                let (rp, rm) = (full(&perturb(&st, j, h, c)), full(&perturb(&st, j, -h, c)));
+                for (li, &i) in idx.iter().enumerate() {
+                    let fd = (rp[i] - rm[i]) / (2.0 * h);
+                    let an = k[li * nl + lj];
+                    // Central differences at h = 1e-6: error ~1e-10 relative; 1e-6 leaves room
+                    // for round-off in the residual (entries are O(10)).
+                    assert!(
+                        (fd - an).abs() < 1e-6 * (1.0 + fd.abs()),
+                        "case {case}, element {ei} ({:?}), row {i}{}, column {j}: analytic {an}, finite differences {fd}",
+                        std::mem::discriminant(el),
+                        if i >= 13 && rate_rows.get(i - 13).copied().unwrap_or(false) { " (rate row)" } else { "" },
+                    );
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,661 @@
+//! Joints: constraint rows between two markers, with exact Jacobians and their derivatives
+//! (THEORY §5, §6).
+//!
+//! Every user-facing joint lowers to one [`Joint`]: two ends and a list of primitive [`Row`]s.
+//! A row is a scalar function `G` of the two ends (and of the revolute angle `phi`), its
+//! gradient over 13 slots `(u_A, theta_A, u_B, theta_B, phi)` and the derivative of
+//! `mu * grad G` (the "geometric stiffness"). Slots an end does not have (a ground, a point
+//! mass's rotation) are computed but not assembled. Rows with a prescribed motion subtract a
+//! time function; rate rows are velocity-level constraints `grad G . V - f(t)`.
+
+use super::rotation::{tilde, M3, V3};
+use super::timefn::TimeFn;
+use super::{m3, Augment, Rate, Residual, State, TangentCoeffs};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::PI;
+
+/// Slots of the 13-component generalized vectors of a joint.
+const UA: usize = 0;
+const TA: usize = 3;
+const UB: usize = 6;
+const TB: usize = 9;
+const PHI: usize = 12;
+pub(crate) const SLOTS: usize = 13;
+
+pub(crate) type Grad = [f64; SLOTS];
+pub(crate) type Hess = [[f64; SLOTS]; SLOTS];
+
+/// One end of a joint, spring or load: a marker (point and axes).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "end", rename_all = "snake_case")]
+pub enum End {
+    /// Fixed in the inertial frame. `axes`: columns are the marker axes.
+    Ground {
+        point: [f64; 3],
+        axes: [[f64; 3]; 3],
+    },
+    /// On a point mass: it translates and never rotates.
+    Point {
+        dofs: [usize; 3],
+        axes: [[f64; 3]; 3],
+    },
+    /// On a rotating node, at `offset` from it; `offset` and `axes` in inertial components at
+    /// t = 0 (they turn with the node's rotation).
+    Node {
+        dofs: [usize; 6],
+        node: usize,
+        offset: [f64; 3],
+        axes: [[f64; 3]; 3],
+    },
+}
+
+/// An end's kinematics at a state (inertial components).
+#[derive(Clone, Copy, Debug)]
+pub struct EndKin {
+    /// The marker point.
+    pub x: V3,
+    /// From the node to the marker point (zero for grounds and point masses).
+    pub p: V3,
+    /// Marker axes (columns).
+    pub e: M3,
+    /// Velocity of the node's translation and angular velocity.
+    pub v: V3,
+    pub w: V3,
+    /// Acceleration of the node's translation and angular acceleration.
+    pub a: V3,
+    pub dw: V3,
+}
+
+impl End {
+    pub fn dofs(&self) -> &[usize] {
+        match self {
+            End::Ground { .. } => &[],
+            End::Point { dofs, .. } => dofs,
+            End::Node { dofs, .. } => dofs,
+        }
+    }
+
+    pub fn kin(&self, st: &State) -> EndKin {
+        match self {
+            End::Ground { point, axes } => EndKin {
+                x: V3::from(*point),
+                p: V3::zeros(),
+                e: m3(axes),
+                v: V3::zeros(),
+                w: V3::zeros(),
+                a: V3::zeros(),
+                dw: V3::zeros(),
+            },
+            End::Point { dofs, axes } => EndKin {
+                x: V3::from(dofs.map(|i| st.q[i])),
+                p: V3::zeros(),
+                e: m3(axes),
+                v: V3::from(dofs.map(|i| st.v[i])),
+                w: V3::zeros(),
+                a: V3::from(dofs.map(|i| st.a[i])),
+                dw: V3::zeros(),
+            },
+            End::Node {
+                dofs,
+                node,
+                offset,
+                axes,
+            } => {
+                let n = &st.rot[*node];
+                let r = n.matrix();
+                let p = r * V3::from(*offset);
+                EndKin {
+                    x: V3::new(st.q[dofs[0]], st.q[dofs[1]], st.q[dofs[2]]) + p,
+                    p,
+                    e: r * m3(axes),
+                    v: V3::new(st.v[dofs[0]], st.v[dofs[1]], st.v[dofs[2]]),
+                    w: n.omega(),
+                    a: V3::new(st.a[dofs[0]], st.a[dofs[1]], st.a[dofs[2]]),
+                    dw: n.omega_dot(),
+                }
+            }
+        }
+    }
+
+    /// Local positions of this end's slots, starting at local index `at`.
+    fn slot_map(&self, at: usize, base: usize, map: &mut [Option<usize>; SLOTS]) -> usize {
+        let n = self.dofs().len();
+        for (k, m) in map[base..base + n].iter_mut().enumerate() {
+            *m = Some(at + k);
+        }
+        n
+    }
+}
+
+impl EndKin {
+    /// Velocity of the marker point.
+    pub fn point_velocity(&self) -> V3 {
+        self.v + self.w.cross(&self.p)
+    }
+
+    pub fn point_acceleration(&self) -> V3 {
+        self.a + self.dw.cross(&self.p) + self.w.cross(&self.w.cross(&self.p))
+    }
+}
+
+/// Both ends of a joint and its angle, at a state.
+pub(crate) struct Geo {
+    pub a: EndKin,
+    pub b: EndKin,
+    pub phi: f64,
+    /// Generalized velocities `(v_A, w_A, v_B, w_B, phi-dot)`.
+    pub vel: Grad,
+}
+
+impl Geo {
+    pub fn new(a: &End, b: &End, angle: Option<usize>, st: &State) -> Geo {
+        let (ka, kb) = (a.kin(st), b.kin(st));
+        let mut vel = [0.0; SLOTS];
+        vel[UA..UA + 3].copy_from_slice(ka.v.as_slice());
+        vel[TA..TA + 3].copy_from_slice(ka.w.as_slice());
+        vel[UB..UB + 3].copy_from_slice(kb.v.as_slice());
+        vel[TB..TB + 3].copy_from_slice(kb.w.as_slice());
+        let mut phi = 0.0;
+        if let Some(i) = angle {
+            phi = st.q[i];
+            vel[PHI] = st.v[i];
+        }
+        Geo {
+            a: ka,
+            b: kb,
+            phi,
+            vel,
+        }
+    }
+
+    /// `d = x_B - x_A` between the marker points.
+    fn d(&self) -> V3 {
+        self.b.x - self.a.x
+    }
+}
+
+/// A primitive constraint row. Axis indices are 0-based (`a_0` is the marker's first axis).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "row", rename_all = "snake_case")]
+pub enum Row {
+    /// Inertial component `k` of `x_B - x_A`.
+    Point { k: usize },
+    /// `a_i . b_j`: axis `i` of end A against axis `j` of end B.
+    Dot { i: usize, j: usize },
+    /// `a_i . (x_B - x_A) - offset`.
+    Along { i: usize, offset: f64 },
+    /// `wrap(phi_m - phi)`: the revolute's measured angle about `a_2` against its unknown.
+    Angle,
+    /// `|x_B - x_A| - length`.
+    Distance { length: f64 },
+    /// The revolute angle unknown `phi` itself (for forces on it).
+    Phi,
+    /// `phi - f(t)`.
+    AngleDrive { f: TimeFn },
+    /// `phi-dot - f(t)` (velocity level).
+    AngleRate { f: TimeFn },
+    /// `a_2 . (x_B - x_A) - offset - f(t)`.
+    SlideDrive { offset: f64, f: TimeFn },
+    /// `d/dt (a_2 . (x_B - x_A)) - f(t)` (velocity level).
+    SlideRate { f: TimeFn },
+}
+
+impl Row {
+    /// A velocity-level row.
+    pub fn is_rate(&self) -> bool {
+        matches!(self, Row::AngleRate { .. } | Row::SlideRate { .. })
+    }
+
+    /// The prescribed function of time, if any.
+    fn drive(&self) -> Option<&TimeFn> {
+        match self {
+            Row::AngleDrive { f }
+            | Row::AngleRate { f }
+            | Row::SlideDrive { f, .. }
+            | Row::SlideRate { f } => Some(f),
+            _ => None,
+        }
+    }
+
+    /// The geometric part `G` and its gradient.
+    pub(crate) fn geom(&self, g: &Geo) -> (f64, Grad) {
+        let mut gr = [0.0; SLOTS];
+        let value = match self {
+            Row::Point { k } => {
+                let (pa, pb) = (tilde(&g.a.p), tilde(&g.b.p));
+                gr[UA + k] = -1.0;
+                gr[UB + k] = 1.0;
+                for j in 0..3 {
+                    gr[TA + j] = pa[(*k, j)];
+                    gr[TB + j] = -pb[(*k, j)];
+                }
+                g.d()[*k]
+            }
+            Row::Dot { i, j } => {
+                let (a, b) = (g.a.e.column(*i).into_owned(), g.b.e.column(*j).into_owned());
+                let c = a.cross(&b);
+                put(&mut gr, TA, &c);
+                put(&mut gr, TB, &-c);
+                a.dot(&b)
+            }
+            Row::Along { i, offset } => along(g, *i, *offset, &mut gr),
+            Row::SlideDrive { offset, .. } => along(g, 2, *offset, &mut gr),
+            Row::SlideRate { .. } => along(g, 2, 0.0, &mut gr),
+            Row::Angle => {
+                let an = AngleGeo::new(g);
+                put(&mut gr, TA, &an.g);
+                put(&mut gr, TB, &-an.g);
+                gr[PHI] = -1.0;
+                wrap(an.phi_m - g.phi)
+            }
+            Row::Phi | Row::AngleDrive { .. } | Row::AngleRate { .. } => {
+                gr[PHI] = 1.0;
+                g.phi
+            }
+            Row::Distance { length } => {
+                let d = g.d();
+                let len = d.norm();
+                let n = if len > 0.0 { d / len } else { V3::zeros() };
+                distance_grad(g, &n, &mut gr);
+                len - length
+            }
+        };
+        (value, gr)
+    }
+
+    /// Adds `d(mu grad G)/dq` (13 x 13, row = force slot, column = perturbed slot) to `h`.
+    pub(crate) fn hess(&self, g: &Geo, mu: f64, h: &mut Hess) {
+        if mu == 0.0 {
+            return;
+        }
+        match self {
+            Row::Point { k } => {
+                let mut m = V3::zeros();
+                m[*k] = mu;
+                let mt = tilde(&m);
+                block(h, TA, TA, &(-mt * tilde(&g.a.p)));
+                block(h, TB, TB, &(mt * tilde(&g.b.p)));
+            }
+            Row::Dot { i, j } => {
+                let (at, bt) = (
+                    tilde(&g.a.e.column(*i).into_owned()),
+                    tilde(&g.b.e.column(*j).into_owned()),
+                );
+                let (ba, ab) = (bt * at * mu, at * bt * mu);
+                block(h, TA, TA, &ba);
+                block(h, TA, TB, &-ab);
+                block(h, TB, TA, &-ba);
+                block(h, TB, TB, &ab);
+            }
+            Row::Along { i, .. } => along_hess(g, *i, mu, h),
+            Row::SlideDrive { .. } | Row::SlideRate { .. } => along_hess(g, 2, mu, h),
+            Row::Angle => {
+                let an = AngleGeo::new(g);
+                let (da, db) = an.derivatives();
+                block(h, TA, TA, &(da * mu));
+                block(h, TA, TB, &(db * mu));
+                block(h, TB, TA, &(-da * mu));
+                block(h, TB, TB, &(-db * mu));
+            }
+            Row::Phi | Row::AngleDrive { .. } | Row::AngleRate { .. } => {}
+            Row::Distance { .. } => {
+                let d = g.d();
+                let len = d.norm();
+                if len <= 0.0 {
+                    return;
+                }
+                let n = d / len;
+                let proj = (M3::identity() - n * n.transpose()) * (mu / len);
+                // D: d(d)/dq = [-I, p_A~, I, -p_B~].
+                let (pa, pb) = (tilde(&g.a.p), tilde(&g.b.p));
+                let dcols = [
+                    (UA, -M3::identity()),
+                    (TA, pa),
+                    (UB, M3::identity()),
+                    (TB, -pb),
+                ];
+                // Forces: u_A: -mu n, theta_A: -mu p_A~ n, u_B: mu n, theta_B: mu p_B~ n.
+                let rows = [
+                    (UA, -M3::identity()),
+                    (TA, -pa),
+                    (UB, M3::identity()),
+                    (TB, pb),
+                ];
+                for (r0, lr) in rows {
+                    for (c0, dc) in dcols {
+                        block(h, r0, c0, &(lr * proj * dc));
+                    }
+                }
+                let nt = tilde(&n);
+                block(h, TA, TA, &(-nt * pa * mu));
+                block(h, TB, TB, &(nt * pb * mu));
+            }
+        }
+    }
+}
+
+/// `a_i . (x_B - x_A) - offset` and its gradient.
+fn along(g: &Geo, i: usize, offset: f64, gr: &mut Grad) -> f64 {
+    let a = g.a.e.column(i).into_owned();
+    let d = g.d();
+    let w = d + g.a.p;
+    put(gr, UA, &-a);
+    put(gr, TA, &a.cross(&w));
+    put(gr, UB, &a);
+    put(gr, TB, &g.b.p.cross(&a));
+    a.dot(&d) - offset
+}
+
+fn along_hess(g: &Geo, i: usize, mu: f64, h: &mut Hess) {
+    let a = g.a.e.column(i).into_owned();
+    let at = tilde(&a) * mu;
+    let w = g.d() + g.a.p;
+    let pbt = tilde(&g.b.p);
+    block(h, UA, TA, &at);
+    block(h, UB, TA, &-at);
+    block(h, TA, UA, &-at);
+    block(h, TA, UB, &at);
+    block(h, TA, TA, &(tilde(&w) * at));
+    block(h, TA, TB, &(-at * pbt));
+    block(h, TB, TB, &(at * pbt));
+    block(h, TB, TA, &(-pbt * at));
+}
+
+fn distance_grad(g: &Geo, n: &V3, gr: &mut Grad) {
+    put(gr, UA, &-n);
+    put(gr, TA, &(tilde(&g.a.p).transpose() * n));
+    put(gr, UB, n);
+    put(gr, TB, &(-tilde(&g.b.p).transpose() * n));
+}
+
+/// The revolute's measured angle about `a_2` (0-based), from `s = a_1.b_0 - a_0.b_1` and
+/// `c = a_0.b_0 + a_1.b_1` (THEORY §5), with its gradient `g` (on `theta_A`; `-g` on
+/// `theta_B`).
+struct AngleGeo {
+    a: [V3; 2],
+    b: [V3; 2],
+    s: f64,
+    c: f64,
+    sigma: V3,
+    kappa: V3,
+    g: V3,
+    phi_m: f64,
+}
+
+impl AngleGeo {
+    fn new(geo: &Geo) -> AngleGeo {
+        let a = [
+            geo.a.e.column(0).into_owned(),
+            geo.a.e.column(1).into_owned(),
+        ];
+        let b = [
+            geo.b.e.column(0).into_owned(),
+            geo.b.e.column(1).into_owned(),
+        ];
+        let s = a[1].dot(&b[0]) - a[0].dot(&b[1]);
+        let c = a[0].dot(&b[0]) + a[1].dot(&b[1]);
+        let sigma = a[1].cross(&b[0]) - a[0].cross(&b[1]);
+        let kappa = a[0].cross(&b[0]) + a[1].cross(&b[1]);
+        let dd = s * s + c * c;
+        let g = if dd > 0.0 {
+            (sigma * c - kappa * s) / dd
+        } else {
+            V3::zeros()
+        };
+        AngleGeo {
+            a,
+            b,
+            s,
+            c,
+            sigma,
+            kappa,
+            g,
+            phi_m: s.atan2(c),
+        }
+    }
+
+    /// `dg/dtheta_A` and `dg/dtheta_B`.
+    fn derivatives(&self) -> (M3, M3) {
+        let dd = self.s * self.s + self.c * self.c;
+        if dd <= 0.0 {
+            return (M3::zeros(), M3::zeros());
+        }
+        let (a0, a1) = (tilde(&self.a[0]), tilde(&self.a[1]));
+        let (b0, b1) = (tilde(&self.b[0]), tilde(&self.b[1]));
+        let (sig, kap, g) = (self.sigma, self.kappa, self.g);
+        let (s, c) = (self.s, self.c);
+        let common = sig * kap.transpose() - kap * sig.transpose();
+        let q = g * (sig * s + kap * c).transpose() * 2.0;
+        let da = (common + (b0 * a1 - b1 * a0) * c - (b0 * a0 + b1 * a1) * s - q) / dd;
+        let db = (-common - (a1 * b0 - a0 * b1) * c + (a0 * b0 + a1 * b1) * s + q) / dd;
+        (da, db)
+    }
+}
+
+/// Wraps an angle into `(-pi, pi]`.
+fn wrap(x: f64) -> f64 {
+    let y = x - 2.0 * PI * ((x + PI) / (2.0 * PI)).floor();
+    if y <= -PI {
+        y + 2.0 * PI
+    } else {
+        y
+    }
+}
+
+#[inline]
+fn put(gr: &mut Grad, at: usize, v: &V3) {
+    gr[at..at + 3].copy_from_slice(v.as_slice());
+}
+
+#[inline]
+fn block(h: &mut Hess, r0: usize, c0: usize, m: &M3) {
+    for i in 0..3 {
+        for j in 0..3 {
+            h[r0 + i][c0 + j] += m[(i, j)];
+        }
+    }
+}
+
+/// A joint: rows between two ends, with multipliers `first..first + rows.len()` and the
+/// revolute angle unknown `angle`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Joint {
+    pub a: End,
+    pub b: End,
+    pub angle: Option<usize>,
+    pub first: usize,
+    pub rows: Vec<Row>,
+    /// For prismatic joints: the initial `a_2 . d`, so the displacement starts at zero.
+    pub slide_offset: Option<f64>,
+}
+
+impl Joint {
+    pub fn indices(&self) -> Vec<usize> {
+        let mut v = Vec::with_capacity(13 + self.rows.len());
+        v.extend_from_slice(self.a.dofs());
+        v.extend_from_slice(self.b.dofs());
+        v.extend(self.angle);
+        v.extend(self.first..self.first + self.rows.len());
+        v
+    }
+
+    pub fn residual(&self, st: &State, aug: Augment, r: &mut Residual) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        let glob = globals(&self.a, &self.b, self.angle);
+        for (k, row) in self.rows.iter().enumerate() {
+            let m = self.first + k;
+            let (gv, gr) = row.geom(&geo);
+            let f = row.drive().map_or(0.0, |f| f.eval(st.t));
+            let mu = if row.is_rate() {
+                r.constraint[m] = aug.rate_scale * (dot13(&gr, &geo.vel) - f);
+                aug.s * st.lambda[m]
+            } else {
+                let c = gv - f;
+                r.constraint[m] = c;
+                aug.s * st.lambda[m] + aug.p * c
+            };
+            for (s, gi) in glob.iter().enumerate() {
+                if let Some(i) = gi {
+                    r.force[*i] += mu * gr[s];
+                }
+            }
+        }
+    }
+
+    pub fn tangent(&self, st: &State, aug: Augment, c: TangentCoeffs, k: &mut [f64]) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        let (map, m0) = slots(&self.a, &self.b, self.angle);
+        let nl = m0 + self.rows.len();
+        k[..nl * nl].iter_mut().for_each(|x| *x = 0.0);
+        let w = c.force_weight;
+        for (r, row) in self.rows.iter().enumerate() {
+            let m = m0 + r;
+            let (gv, gr) = row.geom(&geo);
+            let f = row.drive().map_or(0.0, |f| f.eval(st.t));
+            let lam = st.lambda[self.first + r];
+            let mut h = [[0.0; SLOTS]; SLOTS];
+            if row.is_rate() {
+                row.hess(&geo, aug.s * lam, &mut h);
+                let mut h1 = [[0.0; SLOTS]; SLOTS];
+                row.hess(&geo, 1.0, &mut h1);
+                for (sj, lj) in map.iter().enumerate() {
+                    let Some(lj) = lj else { continue };
+                    let vh: f64 = (0..SLOTS).map(|si| geo.vel[si] * h1[si][sj]).sum();
+                    // `rate_scale` is `1 / velocity` (the integrator's `beta h / gamma`): the
+                    // row is `s (B + rate_scale position V^T H)`, a unit-weight `s B` in the
+                    // constrained mass matrix too.
+                    k[m * nl + lj] = aug.s * (gr[sj] + aug.rate_scale * c.position * vh);
+                }
+            } else {
+                let cv = gv - f;
+                row.hess(&geo, aug.s * lam + aug.p * cv, &mut h);
+                for (sj, lj) in map.iter().enumerate() {
+                    if let Some(lj) = lj {
+                        k[m * nl + lj] = aug.s * gr[sj];
+                    }
+                }
+                for (si, li) in map.iter().enumerate() {
+                    let Some(li) = li else { continue };
+                    for (sj, lj) in map.iter().enumerate() {
+                        if let Some(lj) = lj {
+                            k[li * nl + lj] += w * c.position * aug.p * gr[si] * gr[sj];
+                        }
+                    }
+                }
+            }
+            for (si, li) in map.iter().enumerate() {
+                let Some(li) = li else { continue };
+                k[li * nl + m] = w * aug.s * gr[si];
+                for (sj, lj) in map.iter().enumerate() {
+                    if let Some(lj) = lj {
+                        k[li * nl + lj] += w * c.position * h[si][sj];
+                    }
+                }
+            }
+        }
+    }
+
+    pub fn constraint_rate(&self, st: &State, rate: Rate, out: &mut [f64]) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        for (k, row) in self.rows.iter().enumerate() {
+            let (_, gr) = row.geom(&geo);
+            let jet = row.drive().map(|f| f.jet(st.t));
+            let (f0, f1, f2) = jet.map_or((0.0, 0.0, 0.0), |j| (j.v, j.d, j.dd));
+            out[self.first + k] = match rate {
+                Rate::Velocity => dot13(&gr, &geo.vel) - if row.is_rate() { f0 } else { f1 },
+                Rate::AccelerationBias => {
+                    let mut h = [[0.0; SLOTS]; SLOTS];
+                    row.hess(&geo, 1.0, &mut h);
+                    let mut vhv = 0.0;
+                    for (i, hi) in h.iter().enumerate() {
+                        vhv += geo.vel[i] * dot13(hi, &geo.vel);
+                    }
+                    vhv - if row.is_rate() { f1 } else { f2 }
+                }
+            };
+        }
+    }
+
+    /// The physical force `mu` of row `row`.
+    pub fn multiplier_force(&self, st: &State, aug: Augment, row: usize) -> f64 {
+        let m = self.first + row;
+        if self.rows[row].is_rate() {
+            aug.s * st.lambda[m]
+        } else {
+            aug.s * st.lambda[m] + aug.p * self.violation_row(st, row)
+        }
+    }
+
+    fn violation_row(&self, st: &State, row: usize) -> f64 {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        let r = &self.rows[row];
+        let f = r.drive().map_or(0.0, |f| f.eval(st.t));
+        let (gv, gr) = r.geom(&geo);
+        if r.is_rate() {
+            dot13(&gr, &geo.vel) - f
+        } else {
+            gv - f
+        }
+    }
+
+    /// The largest constraint violation (position rows; rate rows in their own units).
+    pub fn violation(&self, st: &State) -> f64 {
+        (0..self.rows.len())
+            .map(|r| self.violation_row(st, r).abs())
+            .fold(0.0, f64::max)
+    }
+
+    /// The force and the moment (about the marker point) that the joint applies on end B,
+    /// inertial components.
+    pub fn reaction(&self, st: &State, aug: Augment) -> (V3, V3) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        let (mut f, mut m) = (V3::zeros(), V3::zeros());
+        for (r, row) in self.rows.iter().enumerate() {
+            let mu = self.multiplier_force(st, aug, r);
+            let (_, gr) = row.geom(&geo);
+            f -= V3::new(gr[UB], gr[UB + 1], gr[UB + 2]) * mu;
+            m -= V3::new(gr[TB], gr[TB + 1], gr[TB + 2]) * mu;
+        }
+        (f, m - geo.b.p.cross(&f))
+    }
+
+    /// A prismatic joint's displacement and speed along its axis.
+    pub fn slide(&self, st: &State) -> (f64, f64) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        let mut gr = [0.0; SLOTS];
+        let x = along(&geo, 2, self.slide_offset.unwrap_or(0.0), &mut gr);
+        (x, dot13(&gr, &geo.vel))
+    }
+}
+
+/// Local position of each slot for ends `a`, `b` and angle unknown, in the local order
+/// `(a dofs, b dofs, angle)`, and the number of local coordinates.
+pub(crate) fn slots(a: &End, b: &End, angle: Option<usize>) -> ([Option<usize>; SLOTS], usize) {
+    let mut map = [None; SLOTS];
+    let na = a.slot_map(0, UA, &mut map);
+    let nb = b.slot_map(na, UB, &mut map);
+    let mut at = na + nb;
+    if angle.is_some() {
+        map[PHI] = Some(at);
+        at += 1;
+    }
+    (map, at)
+}
+
+/// The global unknown of each slot (no allocation: called every iteration).
+pub(crate) fn globals(a: &End, b: &End, angle: Option<usize>) -> [Option<usize>; SLOTS] {
+    let mut g = [None; SLOTS];
+    for (k, d) in a.dofs().iter().enumerate() {
+        g[UA + k] = Some(*d);
+    }
+    for (k, d) in b.dofs().iter().enumerate() {
+        g[UB + k] = Some(*d);
+    }
+    g[PHI] = angle;
+    g
+}
+
+#[inline]
+pub(crate) fn dot13(a: &Grad, b: &Grad) -> f64 {
+    a.iter().zip(b).map(|(x, y)| x * y).sum()
+}
