@@ -44,3 +44,25 @@ pub fn simulate(model: &str, sets: &[&str], overrides: Overrides) -> Trace {
         mbd::output::read_csv(&String::from_utf8(out).expect("utf-8 CSV")).expect("CSV");
     Trace { header, rows }
 }
+
+/// Compiles and runs model text; on a run-time failure returns the rows written before it and
+/// the failure message.
+pub fn simulate_text(
+    name: &str,
+    text: &str,
+    overrides: Overrides,
+) -> Result<Trace, (Trace, String)> {
+    let compiled = match mbd::compile(name, text, &[], overrides) {
+        Ok(c) => c,
+        Err(f) => panic!("{name} does not compile: {:?}", f.diagnostics),
+    };
+    let mut out = Vec::new();
+    let failure = mbd::run(&compiled, &mut out).err();
+    let (header, rows) =
+        mbd::output::read_csv(&String::from_utf8(out).expect("utf-8 CSV")).expect("CSV");
+    let trace = Trace { header, rows };
+    match failure {
+        None => Ok(trace),
+        Some(f) => Err((trace, f.diagnostic.message)),
+    }
+}

@@ -8,4 +8,6 @@ mod docs;
 mod grammar;
 mod models;
 mod pendulum;
+mod reference;
+mod rigid;
 mod robustness;

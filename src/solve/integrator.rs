@@ -610,9 +610,9 @@ impl<'s> Integrator<'s> {
             }
             // Converged: a small increment, and a small residual or an increment at round-off
             // level (the residual then holds the round-off of accelerations, amplified by
-            // 1/(beta h^2)).
+            // 1/(beta h^2)): 1e-3 of the increment tolerance.
             let settled =
-                rnorm <= self.set.residual_tolerance * scale || last_increment <= 1e-4 * atol;
+                rnorm <= self.set.residual_tolerance * scale || last_increment <= 1e-3 * atol;
             if increment_ok && settled && cnorm <= ltol {
                 self.stats.newton_iterations += it;
                 self.stats.max_constraint_violation =
