@@ -248,6 +248,15 @@ pub struct RunFailure {
 
 /// Simulates a compiled model, writing CSV rows to `out` as they are computed.
 pub fn run(c: &Compiled, out: &mut dyn Write) -> Result<RunReport, RunFailure> {
+    run_with_progress(c, out, &mut |_, _| {})
+}
+
+/// [`run`], calling `progress(step, steps)` after every step.
+pub fn run_with_progress(
+    c: &Compiled,
+    out: &mut dyn Write,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<RunReport, RunFailure> {
     let set = c.settings();
     let l = match &c.lowered {
         Ok(l) => l,
@@ -324,6 +333,7 @@ pub fn run(c: &Compiled, out: &mut dyn Write) -> Result<RunReport, RunFailure> {
         if let Err(f) = hht.step(k, set.dt) {
             return Err(fail(f, &mut csv, warnings, rows));
         }
+        progress(k, set.steps);
         // Exact step times, free of accumulated round-off.
         hht.set_time(k as f64 * set.dt);
         if k % set.every == 0 || k == set.steps {

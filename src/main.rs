@@ -411,7 +411,34 @@ fn run(
         None => Box::new(std::io::stdout().lock()),
     };
     let started = std::time::Instant::now();
-    match mbd::run(&c, &mut sink) {
+    // A progress bar on a terminal, once a run has taken a second.
+    let terminal = std::io::stderr().is_terminal();
+    let mut bar: Option<indicatif::ProgressBar> = None;
+    let mut progress = |k: usize, n: usize| {
+        if !terminal || !k.is_multiple_of(64) && k != n {
+            return;
+        }
+        if bar.is_none() && started.elapsed().as_secs_f64() > 1.0 {
+            let b = indicatif::ProgressBar::new(n as u64);
+            if let Ok(style) = indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] step {pos}/{len}, {eta} left",
+            ) {
+                b.set_style(style.progress_chars("=> "));
+            }
+            bar = Some(b);
+        }
+        if let Some(b) = &bar {
+            b.set_position(k as u64);
+            if k == n {
+                b.finish_and_clear();
+            }
+        }
+    };
+    let result = mbd::run_with_progress(&c, &mut sink, &mut progress);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    match result {
         Ok(r) => {
             report(&r.warnings, &c.sources, format);
             if format == Format::Human {

@@ -1,0 +1,52 @@
+//! Benchmarks of the rigid runtime: the two-bar runs of P3 (1,000 steps) and P4 under each
+//! rotation treatment. Per-step cost = the median divided by 1,000; Newton iterations per step
+//! are printed once before timing.
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use mbd::model::{Overrides, Rotations};
+
+fn text(model: &str) -> String {
+    std::fs::read_to_string(format!("{}/models/{model}", env!("CARGO_MANIFEST_DIR")))
+        .unwrap_or_default()
+}
+
+fn runs(c: &mut Criterion) {
+    for model in ["two_bar.mbd", "two_bar_spin.mbd", "pendulum.mbd"] {
+        let source = text(model);
+        for (name, rotations) in [
+            ("incremental", Rotations::Incremental),
+            ("conformal", Rotations::Conformal),
+        ] {
+            let o = Overrides {
+                rotations: Some(rotations),
+                ..Overrides::default()
+            };
+            let Ok(compiled) = mbd::compile(model, &source, &[], o) else {
+                continue;
+            };
+            let mut out = Vec::with_capacity(1 << 20);
+            match mbd::run(&compiled, &mut out) {
+                Ok(r) => eprintln!(
+                    "{model} {name}: {} steps, {:.2} Newton iterations per step, {} halvings",
+                    r.stats.steps,
+                    r.stats.newton_iterations as f64 / r.stats.steps as f64,
+                    r.stats.halvings
+                ),
+                Err(f) => eprintln!("{model} {name}: failed ({})", f.diagnostic.message),
+            }
+            c.bench_function(&format!("{model}: run, {name} rotations"), |b| {
+                b.iter(|| {
+                    out.clear();
+                    mbd::run(&compiled, &mut out).is_ok()
+                })
+            });
+        }
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(20);
+    targets = runs
+}
+criterion_main!(benches);
