@@ -169,6 +169,7 @@ impl Compiled {
                 model::Integrator::Hht => Method::Hht,
                 model::Integrator::GeneralizedAlpha => Method::GeneralizedAlpha,
                 model::Integrator::Fet => Method::Fet,
+                model::Integrator::Static => Method::Static,
             },
             alpha: s.alpha,
             rho_inf: s.rho_inf,
@@ -186,7 +187,12 @@ impl Compiled {
             increment_tolerance: s.tolerance,
             residual_tolerance: 1e-8,
             max_iterations: s.max_iterations,
-            max_halvings: 1,
+            // Statics: a load step that fails is split, up to 1/16 of its size.
+            max_halvings: if s.integrator == model::Integrator::Static {
+                4
+            } else {
+                1
+            },
         }
     }
 
@@ -348,4 +354,72 @@ pub fn run_with_progress(
         warnings,
         rows,
     })
+}
+
+/// Modal analysis of a compiled model about its initial state (`mbd modes`): the modes by
+/// increasing natural frequency.
+pub fn modes(c: &Compiled) -> Result<solve::modes::Modes, Diagnostic> {
+    let l = c.lowered.as_ref().map_err(Clone::clone)?;
+    solve::modes::modes(&l.system, &c.settings()).map_err(|f| c.failure_diagnostic(&f))
+}
+
+/// Writes the modes table: `mode, frequency_hz, omega_rad_s, damping_ratio, real_per_s,
+/// imag_rad_s` (the first `count`).
+pub fn write_modes(
+    m: &solve::modes::Modes,
+    count: usize,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
+    writeln!(
+        out,
+        "mode,frequency_hz,omega_rad_s,damping_ratio,real_per_s,imag_rad_s"
+    )?;
+    for (i, md) in m.modes.iter().take(count).enumerate() {
+        writeln!(
+            out,
+            "{},{},{},{},{},{}",
+            i + 1,
+            md.frequency_hz(),
+            md.omega(),
+            md.damping_ratio(),
+            md.s.re,
+            md.s.im
+        )?;
+    }
+    Ok(())
+}
+
+/// Writes the mode shapes: `mode, unknown, entity, kind, real, imag`, one row per unknown of
+/// each mode (translations in m, rotations in rad, scaled so the largest entry is 1).
+pub fn write_shapes(
+    c: &Compiled,
+    m: &solve::modes::Modes,
+    count: usize,
+    out: &mut dyn Write,
+) -> std::io::Result<()> {
+    let Ok(l) = &c.lowered else { return Ok(()) };
+    let sys = &l.system;
+    writeln!(out, "mode,unknown,entity,kind,real,imag")?;
+    for (i, md) in m.modes.iter().take(count).enumerate() {
+        for (u, z) in md.shape.iter().enumerate() {
+            let kind = match sys.unknowns[u] {
+                runtime::UnknownKind::Coordinate => "coordinate".to_string(),
+                runtime::UnknownKind::Rotation { axis, .. } => {
+                    format!("rotation_{}", ["x", "y", "z"][axis])
+                }
+                _ => continue,
+            };
+            writeln!(
+                out,
+                "{},{},{},{},{},{}",
+                i + 1,
+                u,
+                sys.entities[sys.owners[u]].name,
+                kind,
+                z.re,
+                z.im
+            )?;
+        }
+    }
+    Ok(())
 }

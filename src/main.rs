@@ -70,6 +70,26 @@ enum Command {
         #[arg(long, value_enum, default_value = "human")]
         format: Format,
     },
+    /// Natural frequencies and mode shapes about the initial state, as CSV.
+    Modes {
+        /// The model file.
+        model: String,
+        /// Write the frequency table here (default: standard output).
+        #[arg(short = 'o', long = "output")]
+        output: Option<String>,
+        /// Write the mode shapes here.
+        #[arg(long)]
+        shapes: Option<String>,
+        /// How many modes, by increasing frequency.
+        #[arg(long, default_value_t = 10)]
+        count: usize,
+        /// Override a param: NAME=VALUE.
+        #[arg(long = "set", value_name = "NAME=VALUE")]
+        set: Vec<String>,
+        /// Diagnostics format.
+        #[arg(long, value_enum, default_value = "human")]
+        format: Format,
+    },
     /// Check a model and print a summary, or one stage of the compilation.
     Check {
         model: String,
@@ -90,6 +110,7 @@ enum IntegratorArg {
     Hht,
     GeneralizedAlpha,
     Fet,
+    Static,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -148,6 +169,21 @@ fn main() -> ExitCode {
             emit,
             set,
         } => check(&model, format, emit, &set),
+        Command::Modes {
+            model,
+            output,
+            shapes,
+            count,
+            set,
+            format,
+        } => modes(
+            &model,
+            output.as_deref(),
+            shapes.as_deref(),
+            count,
+            &set,
+            format,
+        ),
         Command::Run {
             model,
             output,
@@ -191,6 +227,7 @@ fn main() -> ExitCode {
                     IntegratorArg::Hht => Integrator::Hht,
                     IntegratorArg::GeneralizedAlpha => Integrator::GeneralizedAlpha,
                     IntegratorArg::Fet => Integrator::Fet,
+                    IntegratorArg::Static => Integrator::Static,
                 }),
                 alpha,
                 rho_inf,
@@ -378,6 +415,78 @@ impl mbd::model::Loader for FsLoader {
         }
         Err(None)
     }
+}
+
+fn modes(
+    path: &str,
+    output: Option<&str>,
+    shapes: Option<&str>,
+    count: usize,
+    sets: &[String],
+    format: Format,
+) -> ExitCode {
+    let text = match read(path) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    let c = match mbd::compile_with(path, &text, sets, Overrides::default(), &FsLoader::new()) {
+        Ok(c) => c,
+        Err(f) => {
+            report(&f.diagnostics, &f.sources, format);
+            return ExitCode::from(EXIT_MODEL);
+        }
+    };
+    report(&c.warnings, &c.sources, format);
+    let m = match mbd::modes(&c) {
+        Ok(m) => m,
+        Err(d) => {
+            report(std::slice::from_ref(&d), &c.sources, format);
+            return ExitCode::from(if c.lowered.is_err() {
+                EXIT_MODEL
+            } else {
+                EXIT_RUNTIME
+            });
+        }
+    };
+    let open = |p: Option<&str>| -> Result<Box<dyn Write>, ExitCode> {
+        match p {
+            Some(p) => std::fs::File::create(p)
+                .map(|f| Box::new(f) as Box<dyn Write>)
+                .map_err(|e| usage(&format!("cannot create output file `{p}`: {e}"))),
+            None => Ok(Box::new(std::io::stdout().lock())),
+        }
+    };
+    let mut sink = match open(output) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    if let Err(e) = mbd::write_modes(&m, count, &mut sink) {
+        return usage(&format!("cannot write the modes: {e}"));
+    }
+    if let Some(p) = shapes {
+        let mut sink = match open(Some(p)) {
+            Ok(s) => s,
+            Err(code) => return code,
+        };
+        if let Err(e) = mbd::write_shapes(&c, &m, count, &mut sink) {
+            return usage(&format!("cannot write the shapes: {e}"));
+        }
+    }
+    if format == Format::Human {
+        eprintln!(
+            "{}: {} modes{}{}",
+            c.model.name,
+            m.modes.len().min(count),
+            m.spin
+                .map(|w| format!(
+                    ", referred to the frame spinning at ({:.6}, {:.6}, {:.6}) rad/s",
+                    w[0], w[1], w[2]
+                ))
+                .unwrap_or_default(),
+            output.map(|p| format!(" to {p}")).unwrap_or_default()
+        );
+    }
+    ExitCode::SUCCESS
 }
 
 fn run(

@@ -1,6 +1,7 @@
 //! One integration-test binary (keeps link time down); each module is one concern.
 
 mod architecture;
+mod beams;
 mod cli;
 mod common;
 mod diagnostics;

@@ -5,6 +5,7 @@
 //! span it came from. Raises no user errors (the model stage has caught them), except E0501
 //! for what this version's runtime cannot simulate (beams).
 
+mod beams;
 mod joints;
 
 use crate::diagnostics::{Code, Diagnostic};
@@ -26,17 +27,35 @@ pub struct Provenance {
     pub spans: Vec<Span>,
 }
 
-/// What this version's runtime cannot simulate yet, if anything (E0501, with a span).
+/// What this version's runtime cannot simulate yet, if anything (E0501, with a span): a joint,
+/// spring or load at a point between the nodes of an elastic beam.
 fn unsupported(model: &Model) -> Option<Diagnostic> {
-    let not_yet = |what: String, span: Span| {
-        Some(
-            Diagnostic::error(Code::E0501, format!("{what} cannot be simulated by this version of the runtime"))
-                .at(span, "declared here")
-                .hint("the model is valid (`mbd check` accepts it); this version simulates point masses, rigid bodies, joints, springs and loads, not elastic beams yet"),
-        )
+    let between = |m: &Marker| match m.attach {
+        Attach::BeamPoint { beam, s } => Some((beam, s)),
+        _ => None,
     };
-    if let Some(b) = model.beams.first() {
-        return not_yet(format!("beam `{}`", b.name), b.span);
+    let markers = model
+        .joints
+        .iter()
+        .flat_map(|j| j.markers.iter())
+        .chain(model.springs.iter().flat_map(|s| s.markers.iter()))
+        .chain(model.loads.iter().map(|l| &l.marker));
+    for m in markers {
+        if let Some((beam, s)) = between(m) {
+            let b = &model.beams[beam];
+            let h = b.length / (b.nodes.len() - 1) as f64;
+            return Some(
+                Diagnostic::error(
+                    Code::E0501,
+                    format!("`{}` is between two nodes of beam `{}`: this version connects joints, springs and loads to beam nodes only", m.text, b.name),
+                )
+                .at(m.span, "between nodes")
+                .hint(format!(
+                    "nodes of `{}` are every {h} m; choose `elements` and `order` so that a node falls at s = {s} m, and name it `node[k]`",
+                    b.name
+                )),
+            );
+        }
     }
     None
 }
@@ -46,6 +65,8 @@ pub(crate) struct Lower<'m> {
     pub model: &'m Model,
     /// Rotating node of each body (rigid bodies only).
     pub node_of: Vec<Option<usize>>,
+    /// Rotating node of each beam node.
+    pub beam_nodes: Vec<Vec<usize>>,
 }
 
 impl Lower<'_> {
@@ -81,7 +102,18 @@ impl Lower<'_> {
                     },
                 }
             }
-            // Grounds, and beam points (not reached: beams are rejected before).
+            Attach::BeamNode { beam, node } => {
+                let s = self.model.dofs.node_start[beam][node];
+                let x0 = V3::from(self.model.beams[beam].initial_nodes[node]);
+                End::Node {
+                    dofs: [s, s + 1, s + 2, s + 3, s + 4, s + 5],
+                    node: self.beam_nodes[beam][node],
+                    offset: (position - x0).into(),
+                    axes,
+                }
+            }
+            // Grounds, and points between beam nodes (rejected before, except for outputs,
+            // which lower them separately).
             _ => End::Ground {
                 point: position.into(),
                 axes,
@@ -108,7 +140,23 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
             node_of.push(None);
         }
     }
-    let lw = Lower { model, node_of };
+    let rigid_nodes = rotations.len();
+    let mut beam_nodes = Vec::new();
+    for (bi, b) in model.beams.iter().enumerate() {
+        let mut ids = Vec::new();
+        for k in 0..b.nodes.len() {
+            ids.push(rotations.len());
+            rotations.push(dofs.node_start[bi][k] + 3);
+            translations.push(dofs.node_start[bi][k]);
+        }
+        beam_nodes.push(ids);
+    }
+    let rotations_len = rotations.len();
+    let lw = Lower {
+        model,
+        node_of,
+        beam_nodes,
+    };
     let mut entities = Vec::new();
     let mut spans = Vec::new();
     for b in &model.bodies {
@@ -123,6 +171,14 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
         spans.push(b.span);
     }
     let nb = entities.len();
+    for b in &model.beams {
+        entities.push(Entity {
+            name: b.name.clone(),
+            kind: "beam".to_string(),
+        });
+        spans.push(b.span);
+    }
+    let njoint0 = entities.len();
     for j in &model.joints {
         entities.push(Entity {
             name: j.name.clone(),
@@ -152,6 +208,9 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
                 gravity: model.gravity,
             })),
         }
+    }
+    for (bi, b) in model.beams.iter().enumerate() {
+        beams::beam(&lw, bi, b, &mut elements, &mut initial);
     }
     // Joints: element index of each, and whether each multiplier is a rate row.
     let mut joint_element = Vec::new();
@@ -190,21 +249,23 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
                 Some(node) => (UnknownKind::Rotation { node, axis }, body),
                 None => (UnknownKind::Coordinate, body),
             },
-            Unknown::JointAngle { joint } => (UnknownKind::Coordinate, nb + joint),
+            Unknown::JointAngle { joint } => (UnknownKind::Coordinate, njoint0 + joint),
             Unknown::Multiplier { joint, .. } => (
                 if rate_rows[i] {
                     UnknownKind::RateMultiplier
                 } else {
                     UnknownKind::Multiplier
                 },
-                nb + joint,
+                njoint0 + joint,
             ),
-            Unknown::NodeTranslation { .. } | Unknown::NodeRotation { .. } => {
-                return Err(Diagnostic::error(
-                    Code::E0501,
-                    "internal: beam unknowns reached the lowering",
-                ))
-            }
+            Unknown::NodeTranslation { beam, .. } => (UnknownKind::Coordinate, nb + beam),
+            Unknown::NodeRotation { beam, node, axis } => (
+                UnknownKind::Rotation {
+                    node: lw.beam_nodes[beam][node],
+                    axis,
+                },
+                nb + beam,
+            ),
         };
         unknowns.push(kind);
         owners.push(owner);
@@ -221,6 +282,7 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
         unknowns,
         owners,
         rotations,
+        coupled: (0..rotations_len).map(|k| k < rigid_nodes).collect(),
         translations,
         entities,
         elements,
@@ -276,6 +338,12 @@ fn probe(lw: &Lower, p: &ModelProbe, joint_element: &[usize]) -> Probe {
             }
         }
         ModelProbe::Point {
+            attach: Attach::BeamPoint { beam, s },
+            quantity: q,
+            component,
+            ..
+        } => beams::between_nodes(lw, beam, s, quantity(q), component),
+        ModelProbe::Point {
             attach,
             offset,
             quantity: q,
@@ -286,6 +354,11 @@ fn probe(lw: &Lower, p: &ModelProbe, joint_element: &[usize]) -> Probe {
                     let b = &lw.model.bodies[body];
                     let o = m3(&b.orientation);
                     (V3::from(b.position) + o * V3::from(offset), o)
+                }
+                Attach::BeamNode { beam, node } => {
+                    let b = &lw.model.beams[beam];
+                    let o = m3(&b.frame);
+                    (V3::from(b.initial_nodes[node]) + o * V3::from(offset), o)
                 }
                 _ => (V3::from(offset), M3::identity()),
             };

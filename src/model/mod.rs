@@ -405,6 +405,8 @@ pub enum Integrator {
     /// Generalized-alpha (Arnold-Bruls form).
     GeneralizedAlpha,
     Fet,
+    /// Static equilibrium at each step's time (load steps).
+    Static,
 }
 
 /// How rotations are integrated.

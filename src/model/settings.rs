@@ -44,10 +44,11 @@ impl Builder<'_> {
                 "hht" => Integrator::Hht,
                 "generalized_alpha" => Integrator::GeneralizedAlpha,
                 "fet" => Integrator::Fet,
+                "static" => Integrator::Static,
                 other => {
-                    let hint = match did_you_mean(other, ["hht", "generalized_alpha", "fet"]) {
-                        Some(s) => format!("did you mean `{s}`? Solvers: hht, generalized_alpha, fet"),
-                        None => "solvers: hht (HHT-alpha), generalized_alpha, fet (time finite elements)".to_string(),
+                    let hint = match did_you_mean(other, ["hht", "generalized_alpha", "fet", "static"]) {
+                        Some(s) => format!("did you mean `{s}`? Solvers: hht, generalized_alpha, fet, static"),
+                        None => "solvers: hht (HHT-alpha), generalized_alpha, fet (time finite elements), static (load steps)".to_string(),
                     };
                     self.error(
                         top,

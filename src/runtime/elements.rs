@@ -2,6 +2,7 @@
 //!
 //! Local tangent matrices are dense, row-major, over the element's `indices()` in order.
 
+use super::beams::BeamElement;
 use super::bodies::{PointMass, RigidBody};
 use super::forces::{Load, Spring};
 use super::joints::Joint;
@@ -13,6 +14,7 @@ use serde::{Deserialize, Serialize};
 pub enum Element {
     PointMass(PointMass),
     RigidBody(RigidBody),
+    Beam(BeamElement),
     Joint(Joint),
     Spring(Spring),
     Load(Load),
@@ -24,6 +26,7 @@ impl Element {
         match self {
             Element::PointMass(p) => p.dofs.to_vec(),
             Element::RigidBody(b) => b.dofs.to_vec(),
+            Element::Beam(b) => b.dofs.clone(),
             Element::Joint(j) => j.indices(),
             Element::Spring(s) => s.indices(),
             Element::Load(l) => l.end.dofs().to_vec(),
@@ -34,6 +37,7 @@ impl Element {
         match self {
             Element::PointMass(p) => Some(p.mass),
             Element::RigidBody(b) => Some(b.mass),
+            Element::Beam(b) => Some(b.total_mass() / b.len() as f64),
             _ => None,
         }
     }
@@ -43,6 +47,7 @@ impl Element {
         match self {
             Element::PointMass(p) => p.residual(st, r),
             Element::RigidBody(b) => b.residual(st, r),
+            Element::Beam(b) => b.residual(st, r),
             Element::Joint(j) => j.residual(st, aug, r),
             Element::Spring(s) => s.residual(st, r),
             Element::Load(l) => l.residual(st, r),
@@ -54,6 +59,7 @@ impl Element {
         match self {
             Element::PointMass(p) => p.tangent(c, k),
             Element::RigidBody(b) => b.tangent(st, c, k),
+            Element::Beam(b) => b.tangent(st, c, k),
             Element::Joint(j) => j.tangent(st, aug, c, k),
             Element::Spring(s) => s.tangent(st, c, k),
             Element::Load(l) => l.tangent(st, c, k),
@@ -67,10 +73,19 @@ impl Element {
         }
     }
 
+    /// A typical diagonal stiffness of an elastic element, for constraint scaling.
+    pub fn stiffness_scale(&self) -> Option<f64> {
+        match self {
+            Element::Beam(b) => Some(b.stiffness_scale()),
+            _ => None,
+        }
+    }
+
     pub fn energy(&self, st: &State) -> Energy {
         match self {
             Element::PointMass(p) => p.energy(st),
             Element::RigidBody(b) => b.energy(st),
+            Element::Beam(b) => b.energy(st),
             Element::Spring(s) => s.energy(st),
             Element::Joint(_) | Element::Load(_) => Energy::default(),
         }

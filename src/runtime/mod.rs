@@ -11,6 +11,7 @@
 //! the integrator (THEORY §1, §7.1).
 
 mod assembly;
+mod beams;
 mod bodies;
 mod elements;
 mod forces;
@@ -20,6 +21,7 @@ pub mod rotation;
 pub mod timefn;
 
 pub use assembly::{Assembler, Pattern};
+pub use beams::BeamElement;
 pub use bodies::{PointMass, RigidBody};
 pub use elements::Element;
 pub use forces::{Load, LoadKind, Spring, SpringKind};
@@ -72,6 +74,10 @@ pub struct System {
     pub rotations: Vec<usize>,
     /// The first of the three translation unknowns of each rotating node (its position).
     pub translations: Vec<usize>,
+    /// Per rotating node: whether its translation and rotation move together as one SE(3)
+    /// frame (rigid bodies), or separately (beam nodes: SO(3) x R^3). Empty: all frames.
+    #[serde(default)]
+    pub coupled: Vec<bool>,
     pub entities: Vec<Entity>,
     pub elements: Vec<Element>,
     pub initial: State,
@@ -83,6 +89,29 @@ pub struct System {
 impl System {
     pub fn len(&self) -> usize {
         self.unknowns.len()
+    }
+
+    /// The `(multiplier, angle unknown)` pairs of the revolute joints' angle rows, whose
+    /// velocity constraint is `phi-dot_measured - phi-dot`.
+    pub fn angle_rows(&self) -> Vec<(usize, usize)> {
+        self.elements
+            .iter()
+            .filter_map(|e| match e {
+                Element::Joint(j) => j.angle.and_then(|a| {
+                    j.rows
+                        .iter()
+                        .position(|r| matches!(r, Row::Angle))
+                        .map(|r| (j.first + r, a))
+                }),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Whether rotating node `k` is an SE(3) frame (see `coupled`).
+    #[inline]
+    pub fn is_frame(&self, k: usize) -> bool {
+        self.coupled.get(k).copied().unwrap_or(true)
     }
 
     pub fn is_empty(&self) -> bool {
@@ -104,9 +133,18 @@ impl System {
         }
     }
 
-    /// Mean elastic stiffness diagonal, for constraint scaling (no elastic elements yet).
+    /// Mean elastic stiffness diagonal, for constraint scaling (THEORY §6).
     pub fn mean_stiffness(&self) -> f64 {
-        0.0
+        let k: Vec<f64> = self
+            .elements
+            .iter()
+            .filter_map(|e| e.stiffness_scale())
+            .collect();
+        if k.is_empty() {
+            0.0
+        } else {
+            k.iter().sum::<f64>() / k.len() as f64
+        }
     }
 }
 

@@ -63,6 +63,14 @@ pub enum Probe {
     Energy {
         kind: EnergyKind,
     },
+    /// A point between beam nodes: `sum w_k x_k` of the element's node translations (position,
+    /// velocity or acceleration), with the element's shape functions as weights.
+    Interpolated {
+        dofs: Vec<[usize; 3]>,
+        weights: Vec<f64>,
+        quantity: ProbeQuantity,
+        component: usize,
+    },
 }
 
 impl System {
@@ -127,6 +135,22 @@ impl System {
                 Element::Joint(j) => j.violation(st),
                 _ => f64::NAN,
             },
+            Probe::Interpolated {
+                dofs,
+                weights,
+                quantity,
+                component,
+            } => {
+                let v = match quantity {
+                    ProbeQuantity::Velocity => &st.v,
+                    ProbeQuantity::Acceleration => &st.a,
+                    _ => &st.q,
+                };
+                dofs.iter()
+                    .zip(weights)
+                    .map(|(d, w)| w * v[d[*component]])
+                    .sum()
+            }
             Probe::Energy { kind } => {
                 let e = self.energy(st);
                 match kind {

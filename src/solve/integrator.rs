@@ -32,6 +32,8 @@ struct Scheme {
     af: f64,
     beta: f64,
     gamma: f64,
+    /// Static analysis: no inertia, no rates; steps are load steps.
+    stat: bool,
 }
 
 impl Scheme {
@@ -46,6 +48,7 @@ impl Scheme {
                     af,
                     gamma: 0.5 - am + af,
                     beta: 0.25 * (1.0 - am + af).powi(2),
+                    stat: false,
                 }
             }
             // HHT in the Arnold-Bruls form: equations at t_{n+1}, a_m = 0, a_f = -alpha. Same
@@ -56,6 +59,7 @@ impl Scheme {
                 af: -set.alpha,
                 beta: (1.0 - set.alpha).powi(2) / 4.0,
                 gamma: 0.5 - set.alpha,
+                stat: set.method == Method::Static,
             },
         }
     }
@@ -93,6 +97,12 @@ pub struct Integrator<'s> {
     stats: RunStats,
     /// Index of the step being taken (for messages).
     step_index: usize,
+    /// The rotating node of each transformed block.
+    block_node: Vec<usize>,
+    /// Weight of the stiffness in the constrained mass matrix: zero, or `beta h^2` when some
+    /// rotations carry no inertia (beams without rotary inertia), whose accelerations the
+    /// mass matrix alone leaves undetermined.
+    start_stiffness: f64,
 }
 
 /// Why a step attempt failed, before it is turned into a [`RuntimeFailure`].
@@ -116,14 +126,16 @@ impl<'s> Integrator<'s> {
             .map_err(|e| setup(format!("the sparse LU could not be set up ({e:?})")))?;
         let conformal = set.rotation == RotationTreatment::Conformal;
         let n = sys.len();
-        let blocks: Vec<usize> = if conformal {
-            sys.rotations.clone()
+        // Transformed 3x3 blocks and the rotating node of each.
+        let nodes = sys.rotations.len();
+        let (blocks, block_node): (Vec<usize>, Vec<usize>) = if conformal {
+            (sys.rotations.clone(), (0..nodes).collect())
         } else {
-            sys.translations
-                .iter()
-                .chain(&sys.rotations)
-                .copied()
-                .collect()
+            (0..nodes)
+                .filter(|&k| sys.is_frame(k))
+                .map(|k| (sys.translations[k], k))
+                .chain((0..nodes).map(|k| (sys.rotations[k], k)))
+                .unzip()
         };
         let transform = Transform::new(n, &blocks, &asm.pattern).ok_or_else(|| {
             setup("internal: a rotating node's unknowns are not coupled as a block".into())
@@ -145,6 +157,7 @@ impl<'s> Integrator<'s> {
             mats: vec![M3::identity(); blocks.len()],
             cols: vec![M3::identity(); blocks.len()],
             blocks,
+            block_node,
             in_frame,
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
@@ -156,6 +169,7 @@ impl<'s> Integrator<'s> {
             },
             stats: RunStats::default(),
             step_index: 0,
+            start_stiffness: 0.0,
         };
         it.aug = it.scaling(set.dt);
         Ok(it)
@@ -180,7 +194,12 @@ impl<'s> Integrator<'s> {
 
     /// `s = p = m/(beta h^2) + k` (THEORY §6); rate rows scaled by `beta h / gamma`.
     fn scaling(&self, h: f64) -> Augment {
-        let k = self.sys.mean_mass() / (self.sc.beta * h * h) + self.sys.mean_stiffness();
+        let inertia = self.sys.mean_mass() / (self.sc.beta * h * h);
+        let k = if self.sc.stat && self.sys.mean_stiffness() > 0.0 {
+            self.sys.mean_stiffness()
+        } else {
+            inertia + self.sys.mean_stiffness()
+        };
         Augment {
             s: k,
             p: k,
@@ -212,7 +231,7 @@ impl<'s> Integrator<'s> {
         let c = TangentCoeffs {
             mass: 1.0,
             velocity: 0.0,
-            position: 0.0,
+            position: self.start_stiffness,
             force_weight: 1.0,
         };
         self.asm.tangent(self.sys, &self.trial, self.aug, c);
@@ -315,6 +334,26 @@ impl<'s> Integrator<'s> {
                 self.trial.a[i] = self.trial.rot[*node].dw[*axis];
             }
         }
+        // Rotations without inertia: the mass matrix alone does not determine them.
+        let c = TangentCoeffs {
+            mass: 1.0,
+            velocity: 0.0,
+            position: 0.0,
+            force_weight: 1.0,
+        };
+        self.asm.tangent(self.sys, &self.trial, self.aug, c);
+        let floor = 1e-12 * self.sys.mean_mass() * self.sys.length_scale.powi(2);
+        let massless = self.sys.unknowns.iter().enumerate().any(|(i, k)| {
+            matches!(k, UnknownKind::Rotation { .. })
+                && self
+                    .asm
+                    .pattern
+                    .slot(i, i)
+                    .is_some_and(|d| self.asm.values[d].abs() <= floor)
+        });
+        if massless {
+            self.start_stiffness = self.sc.beta * self.set.dt * self.set.dt;
+        }
         // Positions: minimum mass-weighted correction, iterated (Gauss-Newton).
         let mut moved = None;
         for _ in 0..50 {
@@ -349,6 +388,28 @@ impl<'s> Integrator<'s> {
                 entity: who,
                 detail: format!("initial positions violated the joints by up to {worst:.3e} m and were projected onto them"),
             });
+        }
+        if self.sc.stat {
+            // Statics: no rates; multipliers come with the first load step.
+            let tr = &mut self.trial;
+            for x in
+                tr.v.iter_mut()
+                    .chain(tr.a.iter_mut())
+                    .chain(tr.lambda.iter_mut())
+            {
+                *x = 0.0;
+            }
+            for r in tr.rot.iter_mut() {
+                (r.w, r.dw) = ([0.0; 3], [0.0; 3]);
+            }
+            return self.finish_initialization(notices);
+        }
+        // Revolute angle rates: the measured relative rates (they carry no mass, so only the
+        // bodies' velocities decide whether the start is consistent).
+        self.asm
+            .constraint_rate(self.sys, &self.trial, Rate::Velocity);
+        for (row, angle) in self.sys.angle_rows() {
+            self.trial.v[angle] += self.asm.residual.constraint[row];
         }
         // Velocities: project onto B v + dC/dt = 0 in the mass metric (the impulsive response).
         self.asm
@@ -396,6 +457,11 @@ impl<'s> Integrator<'s> {
             }
             self.apply_physical(&acc, 2);
         }
+        self.finish_initialization(notices)
+    }
+
+    /// From the physical layout to the treatment's, and the initial state becomes current.
+    fn finish_initialization(&mut self, notices: Vec<Notice>) -> Result<Vec<Notice>, StepFailure> {
         self.trial.alg.clone_from(&self.trial.a);
         if self.conformal {
             rotations::to_conformal(self.sys, &mut self.trial);
@@ -473,20 +539,49 @@ impl<'s> Integrator<'s> {
             rotations::tangents(self.sys, &self.trial, &mut self.mats);
             self.cols.copy_from_slice(&self.mats);
         } else {
+            // Rotation blocks come last, one per node in order.
+            let first = self.blocks.len() - nodes;
             for k in 0..nodes {
                 let r = self.trial.rot[k].matrix();
                 let th = rot::log(&(self.cur.rot[k].matrix().transpose() * r));
-                let c = r * rot::left_jacobian_inverse(&-th);
-                self.mats[k] = r;
-                self.mats[nodes + k] = r;
-                self.cols[k] = c;
-                self.cols[nodes + k] = c;
+                self.mats[first + k] = r;
+                // The correction moves R by exactly R d, and the step increment by
+                // J_r^-1(th) d, on which the Newmark rates depend: R J_r^-1 is exact for the
+                // inertial terms, R for the configuration terms. Beam nodes take R (their
+                // elastic stiffness dominates, and would leak through an O(th) error from stiff
+                // to soft directions), frames R J_r^-1 (their tangent is all inertia).
+                self.cols[first + k] = if self.sys.is_frame(k) && !self.sc.stat {
+                    r * rot::left_jacobian_inverse(&-th)
+                } else {
+                    r
+                };
+            }
+            for b in 0..first {
+                let k = self.block_node[b];
+                self.mats[b] = self.mats[first + k];
+                self.cols[b] = self.cols[first + k];
             }
         }
     }
 
     /// Updates velocities and accelerations of the iterate from its positions (Newmark).
     fn newmark(&mut self, h: f64) {
+        if self.sc.stat {
+            let tr = &mut self.trial;
+            for i in 0..self.sys.len() {
+                if !self.sys.unknowns[i].is_multiplier() {
+                    (tr.v[i], tr.a[i], tr.alg[i]) = (0.0, 0.0, 0.0);
+                }
+            }
+            if self.conformal {
+                rotations::sync(self.sys, tr);
+            }
+            for k in 0..self.sys.rotations.len() {
+                tr.frames[k] = Default::default();
+                (tr.rot[k].w, tr.rot[k].dw) = ([0.0; 3], [0.0; 3]);
+            }
+            return;
+        }
         let Scheme {
             am,
             af,
@@ -537,9 +632,14 @@ impl<'s> Integrator<'s> {
         {
             let (cur, tr) = (&self.cur, &mut self.trial);
             tr.t = cur.t + h;
+            // Statics: the previous load step's equilibrium.
             let step = |v: f64, a: f64, alg0: f64| {
                 let alg = (a - sc.am * alg0) / (1.0 - sc.am);
-                h * v + h * h * ((0.5 - sc.beta) * alg0 + sc.beta * alg)
+                if sc.stat {
+                    0.0
+                } else {
+                    h * v + h * h * ((0.5 - sc.beta) * alg0 + sc.beta * alg)
+                }
             };
             for i in 0..n {
                 if self.sys.unknowns[i].is_multiplier() {
@@ -560,17 +660,27 @@ impl<'s> Integrator<'s> {
             }
         }
         self.newmark(h);
-        let coeffs = TangentCoeffs {
-            mass: sc.mass_coefficient(h),
-            velocity: sc.gamma / (sc.beta * h),
-            position: 1.0,
-            force_weight: 1.0,
+        let coeffs = if sc.stat {
+            TangentCoeffs {
+                mass: 0.0,
+                velocity: 0.0,
+                position: 1.0,
+                force_weight: 1.0,
+            }
+        } else {
+            TangentCoeffs {
+                mass: sc.mass_coefficient(h),
+                velocity: sc.gamma / (sc.beta * h),
+                position: 1.0,
+                force_weight: 1.0,
+            }
         };
         let ltol = self.set.increment_tolerance * self.sys.length_scale;
         let atol = self.set.increment_tolerance;
         let floor = self.sys.mean_mass() * self.sys.length_scale;
         let mut increment_ok = false;
         let mut last_increment = f64::NAN;
+        let mut previous_increment = f64::NAN;
         let mut last = f64::INFINITY;
         let mut growth = 0;
         for it in 0..=self.set.max_iterations {
@@ -609,10 +719,14 @@ impl<'s> Integrator<'s> {
                 }
             }
             // Converged: a small increment, and a small residual or an increment at round-off
-            // level (the residual then holds the round-off of accelerations, amplified by
-            // 1/(beta h^2)): 1e-3 of the increment tolerance.
-            let settled =
-                rnorm <= self.set.residual_tolerance * scale || last_increment <= 1e-3 * atol;
+            // level: 1e-3 of the increment tolerance, or a small increment that no longer
+            // shrinks (Newton's quadratic contraction has reached the noise of the residual,
+            // which holds the round-off of accelerations amplified by 1/(beta h^2) and of stiff
+            // elastic forces).
+            let stalled = last_increment <= atol && last_increment > 0.1 * previous_increment;
+            let settled = rnorm <= self.set.residual_tolerance * scale
+                || last_increment <= 1e-3 * atol
+                || stalled;
             if increment_ok && settled && cnorm <= ltol {
                 self.stats.newton_iterations += it;
                 self.stats.max_constraint_violation =
@@ -698,6 +812,7 @@ impl<'s> Integrator<'s> {
             }
             self.newmark(h);
             increment_ok = dmax <= atol;
+            previous_increment = last_increment;
             last_increment = dmax;
         }
         Err(StepFailure {
@@ -705,5 +820,76 @@ impl<'s> Integrator<'s> {
             entity: None,
             detail: "Newton did not converge".to_string(),
         })
+    }
+}
+
+/// The linearized equations at the current state, dense, over the non-multiplier unknowns
+/// (physical layout: virtual rotations): `M x'' + G x' + K x = 0` subject to `B x = 0`.
+pub struct Linearization {
+    /// The non-multiplier unknowns, in order.
+    pub unknowns: Vec<usize>,
+    pub m: Vec<f64>,
+    pub g: Vec<f64>,
+    pub k: Vec<f64>,
+    /// Constraint rows (one per multiplier), row-major over `unknowns`.
+    pub b: Vec<f64>,
+    pub rows: usize,
+}
+
+impl Integrator<'_> {
+    /// The element matrices at the current state (after `initialize`): mass, gyroscopic and
+    /// damping, stiffness (elastic, inertial, and the constraint forces' geometric stiffness),
+    /// and the constraint gradient (rate rows included: a driven coordinate is not perturbed).
+    pub fn linearize(&mut self) -> Linearization {
+        let n = self.sys.len();
+        let free: Vec<usize> = (0..n).filter(|&i| !self.is_mult(i)).collect();
+        let mults: Vec<usize> = (0..n).filter(|&i| self.is_mult(i)).collect();
+        let mut col = vec![usize::MAX; n];
+        for (j, &i) in free.iter().enumerate() {
+            col[i] = j;
+        }
+        let nf = free.len();
+        let aug = self.aug;
+        let st = self.cur.clone();
+        let mut dense = |c: TangentCoeffs, rows: &[usize]| -> Vec<f64> {
+            self.asm.tangent(self.sys, &st, aug, c);
+            let p = &self.asm.pattern;
+            let mut out = vec![0.0; rows.len() * nf];
+            let mut row_of = vec![usize::MAX; n];
+            for (r, &i) in rows.iter().enumerate() {
+                row_of[i] = r;
+            }
+            for j in 0..n {
+                if col[j] == usize::MAX {
+                    continue;
+                }
+                for s in p.col_ptr[j]..p.col_ptr[j + 1] {
+                    let i = p.row_idx[s];
+                    if row_of[i] != usize::MAX {
+                        out[row_of[i] * nf + col[j]] = self.asm.values[s];
+                    }
+                }
+            }
+            out
+        };
+        let coeffs = |mass: f64, velocity: f64, position: f64| TangentCoeffs {
+            mass,
+            velocity,
+            position,
+            force_weight: 1.0,
+        };
+        let m = dense(coeffs(1.0, 0.0, 0.0), &free);
+        let g = dense(coeffs(0.0, 1.0, 0.0), &free);
+        let k = dense(coeffs(0.0, 0.0, 1.0), &free);
+        let mut b = dense(coeffs(0.0, 1.0, 0.0), &mults);
+        b.iter_mut().for_each(|x| *x /= aug.s);
+        Linearization {
+            unknowns: free,
+            m,
+            g,
+            k,
+            b,
+            rows: mults.len(),
+        }
     }
 }

@@ -133,3 +133,58 @@ mod tests {
         assert!(rhs.iter().all(|x| (x - 1.0).abs() < 1e-14));
     }
 }
+
+/// An orthonormal basis of the null space of the `rows x cols` row-major matrix `b`, as the
+/// columns of a column-major `cols x r` array (singular values below `1e-10` of the largest
+/// count as zero).
+pub fn null_space(b: &[f64], rows: usize, cols: usize) -> Option<(Vec<f64>, usize)> {
+    if rows == 0 {
+        let mut id = vec![0.0; cols * cols];
+        for i in 0..cols {
+            id[i * cols + i] = 1.0;
+        }
+        return Some((id, cols));
+    }
+    let m = faer::Mat::<f64>::from_fn(rows, cols, |i, j| b[i * cols + j]);
+    let svd = m.svd().ok()?;
+    let s = svd.S().column_vector();
+    let smax = (0..s.nrows()).map(|i| s[i].abs()).fold(0.0, f64::max);
+    let rank = (0..s.nrows())
+        .filter(|&i| s[i].abs() > 1e-10 * smax)
+        .count();
+    let v = svd.V();
+    let r = cols - rank;
+    let mut out = vec![0.0; cols * r];
+    for j in 0..r {
+        for i in 0..cols {
+            out[j * cols + i] = v[(i, rank + j)];
+        }
+    }
+    Some((out, r))
+}
+
+/// Generalized eigenvalues `alpha / beta` and right eigenvectors of `A z = s B z` for real
+/// column-major `n x n` matrices (QZ): `(alpha, beta, vector)` with complex numbers as
+/// `(re, im)`.
+#[allow(clippy::type_complexity)]
+pub fn generalized_eigen(
+    a: &[f64],
+    b: &[f64],
+    n: usize,
+) -> Option<Vec<((f64, f64), (f64, f64), Vec<(f64, f64)>)>> {
+    let am = faer::Mat::<f64>::from_fn(n, n, |i, j| a[j * n + i]);
+    let bm = faer::Mat::<f64>::from_fn(n, n, |i, j| b[j * n + i]);
+    let ev = am.generalized_eigen(&bm).ok()?;
+    let (sa, sb, u) = (ev.S_a().column_vector(), ev.S_b().column_vector(), ev.U());
+    Some(
+        (0..n)
+            .map(|e| {
+                (
+                    (sa[e].re, sa[e].im),
+                    (sb[e].re, sb[e].im),
+                    (0..n).map(|i| (u[(i, e)].re, u[(i, e)].im)).collect(),
+                )
+            })
+            .collect(),
+    )
+}

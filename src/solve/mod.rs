@@ -7,6 +7,7 @@
 
 mod integrator;
 pub mod linear;
+pub mod modes;
 mod rotations;
 mod se3;
 
@@ -23,6 +24,9 @@ pub enum Method {
     GeneralizedAlpha,
     /// Time finite elements (not available yet).
     Fet,
+    /// Static equilibrium at each step's time: steps are load steps (loads and prescribed
+    /// motions as functions of time), no inertia.
+    Static,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -7,6 +7,9 @@
 //! The elements stay in inertial components with spatial virtual rotations: the body-frame
 //! correction `(du*, dtheta*)` moves the node by `dx = R du*` and `dtheta = R dtheta*` to first
 //! order, so the iteration matrix is `T^T J T` and the residual `T^T r` with `T = diag(R, R)`.
+//!
+//! Nodes that are not frames (`System::is_frame`, beam nodes) keep only the rotational half:
+//! `R <- R exp(dtheta*)` with Newmark on `R^T omega`, their translations being coordinates.
 
 use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, log, M3, V3};
 use crate::runtime::{State, System};
@@ -28,8 +31,12 @@ pub fn to_frames(sys: &System, st: &mut State) {
     for (k, (&t, &r)) in sys.translations.iter().zip(&sys.rotations).enumerate() {
         let rt = st.rot[k].matrix().transpose();
         let g = |x: &[f64], i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
-        let (v, w) = (rt * g(&st.v, t), rt * g(&st.v, r));
-        let (a, dw) = (rt * g(&st.a, t), rt * g(&st.a, r));
+        let (mut v, w) = (rt * g(&st.v, t), rt * g(&st.v, r));
+        let (mut a, dw) = (rt * g(&st.a, t), rt * g(&st.a, r));
+        if !sys.is_frame(k) {
+            // Translations are integrated as coordinates.
+            (v, a) = (V3::zeros(), V3::zeros());
+        }
         let f = &mut st.frames[k];
         f.v = join(&v, &w);
         f.dv = join(&(a - w.cross(&v)), &dw);
@@ -46,10 +53,13 @@ pub fn to_physical(sys: &System, st: &mut State, k: usize) {
     let (dv, dw) = split(&st.frames[k].dv);
     let (xd, om) = (rm * v, rm * w);
     let (xdd, omd) = (rm * (dv + w.cross(&v)), rm * dw);
+    let frame = sys.is_frame(k);
     for i in 0..3 {
-        st.v[t + i] = xd[i];
+        if frame {
+            st.v[t + i] = xd[i];
+            st.a[t + i] = xdd[i];
+        }
         st.v[r + i] = om[i];
-        st.a[t + i] = xdd[i];
         st.a[r + i] = omd[i];
     }
     st.rot[k].w = om.into();
@@ -61,6 +71,9 @@ pub fn increment(sys: &System, from: &State, to: &State, k: usize) -> [f64; 6] {
     let t = sys.translations[k];
     let r0 = from.rot[k].matrix();
     let th = log(&(r0.transpose() * to.rot[k].matrix()));
+    if !sys.is_frame(k) {
+        return join(&V3::zeros(), &th);
+    }
     let u = left_jacobian_inverse(&th) * (r0.transpose() * (x_of(to, t) - x_of(from, t)));
     join(&u, &th)
 }
@@ -70,9 +83,11 @@ pub fn displace(sys: &System, from: &State, to: &mut State, k: usize, d: &[f64; 
     let t = sys.translations[k];
     let (u, th) = split(d);
     let r0: M3 = from.rot[k].matrix();
-    let x = x_of(from, t) + r0 * (left_jacobian(&th) * u);
-    for i in 0..3 {
-        to.q[t + i] = x[i];
+    if sys.is_frame(k) {
+        let x = x_of(from, t) + r0 * (left_jacobian(&th) * u);
+        for i in 0..3 {
+            to.q[t + i] = x[i];
+        }
     }
     to.rot[k].set_matrix(&(r0 * exp(&th)));
 }
@@ -82,9 +97,11 @@ pub fn displace_in_place(sys: &System, st: &mut State, k: usize, d: &[f64; 6]) {
     let t = sys.translations[k];
     let (u, th) = split(d);
     let r0: M3 = st.rot[k].matrix();
-    let x = x_of(st, t) + r0 * (left_jacobian(&th) * u);
-    for i in 0..3 {
-        st.q[t + i] = x[i];
+    if sys.is_frame(k) {
+        let x = x_of(st, t) + r0 * (left_jacobian(&th) * u);
+        for i in 0..3 {
+            st.q[t + i] = x[i];
+        }
     }
     st.rot[k].set_matrix(&(r0 * exp(&th)));
 }

@@ -12,6 +12,7 @@ use crate::runtime::forces::LoadKind;
 use crate::runtime::joints::{End, Row};
 use crate::runtime::rotation::{exp, V3};
 use crate::runtime::timefn::{Binary, TimeFn, Unary};
+use crate::runtime::BeamElement;
 use crate::runtime::{NodeRotation, SpringKind};
 
 /// A small deterministic generator.
@@ -276,5 +277,131 @@ fn tangents_match_central_differences() {
                 }
             }
         }
+    }
+}
+
+/// A beam element of `nn` nodes at random deformed, moving states: nodes at unknowns
+/// `6k..6k+6`, rotating node `k`; reference line curved and twisted, with a full coupled
+/// section, mass offsets and gravity.
+fn beam_case(rng: &mut Lcg, nn: usize) -> (BeamElement, State) {
+    let mut positions = Vec::new();
+    let mut triads = Vec::new();
+    for k in 0..nn {
+        let s = k as f64 / (nn - 1) as f64;
+        // An arc with a twist: the reference strains are not zero.
+        positions.push([s, 0.3 * s * s, 0.1 * s]);
+        let base = exp(&V3::new(0.4 * s, 0.0, 0.6 * s));
+        triads.push(crate::runtime::arr3(&base));
+    }
+    let mut stiffness = [[0.0; 6]; 6];
+    for i in 0..6 {
+        for j in 0..6 {
+            stiffness[i][j] = 0.3 * rng.next();
+        }
+    }
+    // Symmetric, positive definite: A A^T + diagonal.
+    let a = stiffness;
+    for i in 0..6 {
+        for j in 0..6 {
+            stiffness[i][j] = (0..6).map(|k| a[i][k] * a[j][k]).sum::<f64>()
+                + if i == j { 2.0 + i as f64 } else { 0.0 };
+        }
+    }
+    let rho = {
+        let r = crate::runtime::m3(&rng.rotation(1.0));
+        let d = crate::runtime::rotation::M3::from_diagonal(&V3::new(0.5, 0.2, 0.3));
+        crate::runtime::arr3(&(r * d * r.transpose()))
+    };
+    let dofs: Vec<usize> = (0..6 * nn).collect();
+    let mut beam = BeamElement::new(
+        dofs,
+        (0..nn).collect(),
+        &positions,
+        triads,
+        stiffness,
+        1.3,
+        [0.0, 0.1 * rng.next(), 0.1 * rng.next()],
+        rho,
+        rng.v3(),
+    );
+    beam.load = rng.v3();
+    let mut st = State::zeros(6 * nn, nn);
+    for k in 0..nn {
+        for i in 0..3 {
+            st.q[6 * k + i] = positions[k][i] + 0.1 * rng.next();
+            st.v[6 * k + i] = rng.next();
+            st.a[6 * k + i] = rng.next();
+        }
+        // A large common rotation plus moderate relative ones.
+        let common = exp(&V3::new(1.0, 2.0, -0.5));
+        st.rot[k] = NodeRotation {
+            r: crate::runtime::arr3(&(crate::runtime::m3(&rng.rotation(0.3)) * common)),
+            w: rng.v3(),
+            dw: rng.v3(),
+        };
+    }
+    (beam, st)
+}
+
+#[test]
+fn beam_tangents_match_central_differences() {
+    let mut rng = Lcg(11);
+    for case in 0..30 {
+        let nn = 2 + case % 3;
+        let (beam, st) = beam_case(&mut rng, nn);
+        let c = TangentCoeffs {
+            mass: 1.0 + 5.0 * rng.next().abs(),
+            velocity: 0.5 + 2.0 * rng.next().abs(),
+            position: 1.0,
+            force_weight: 0.8 + 0.2 * rng.next().abs(),
+        };
+        let n = 6 * nn;
+        let el = Element::Beam(beam);
+        let mut k = vec![0.0; n * n];
+        let aug = Augment {
+            s: 1.0,
+            p: 1.0,
+            rate_scale: 1.0,
+        };
+        el.tangent(&st, aug, c, &mut k);
+        let full = |s: &State| {
+            let mut r = Residual::new(n);
+            el.residual(s, aug, &mut r);
+            (0..n)
+                .map(|i| r.inertia[i] + c.force_weight * r.force[i])
+                .collect::<Vec<f64>>()
+        };
+        let perturb = |j: usize, eps: f64| {
+            let mut s = st.clone();
+            let (node, i) = (j / 6, j % 6);
+            if i >= 3 {
+                let mut e = V3::zeros();
+                e[i - 3] = eps * c.position;
+                let r = exp(&e) * s.rot[node].matrix();
+                s.rot[node].set_matrix(&r);
+                s.rot[node].w[i - 3] += eps * c.velocity;
+                s.rot[node].dw[i - 3] += eps * c.mass;
+            } else {
+                s.q[j] += eps * c.position;
+                s.v[j] += eps * c.velocity;
+                s.a[j] += eps * c.mass;
+            }
+            s
+        };
+        let h = 1e-6;
+        let mut worst: f64 = 0.0;
+        for j in 0..n {
+            let (rp, rm) = (full(&perturb(j, h)), full(&perturb(j, -h)));
+            for i in 0..n {
+                let fd = (rp[i] - rm[i]) / (2.0 * h);
+                let an = k[i * n + j];
+                worst = worst.max((fd - an).abs() / (1.0 + fd.abs()));
+                assert!(
+                    (fd - an).abs() < 1e-6 * (1.0 + fd.abs()),
+                    "case {case} ({nn} nodes), row {i}, column {j}: analytic {an}, finite differences {fd}"
+                );
+            }
+        }
+        assert!(worst < 1e-6);
     }
 }

@@ -1,0 +1,105 @@
+//! Lowering of elastic beams: elements between consecutive node groups, concentrated masses,
+//! and the nodes' initial state.
+
+use super::Lower;
+use crate::model::Beam;
+use crate::runtime::rotation::{M3, V3};
+use crate::runtime::{
+    arr3, m3, BeamElement, Element, NodeRotation, Probe, ProbeQuantity, RigidBody, State,
+};
+
+/// Section mass properties in the section frame: `m`, `eta*` and the inertia per length about
+/// the reference line (the section gives it about its centre of mass).
+pub fn section_mass(b: &Beam) -> (f64, [f64; 3], [[f64; 3]; 3]) {
+    let s = &b.section;
+    let m = s.mass_per_length;
+    let eta = V3::new(0.0, s.mass_offset[0], s.mass_offset[1]);
+    let rc = M3::from_diagonal(&V3::new(s.inertia[0], s.inertia[1], s.inertia[2]));
+    let rho = rc + (M3::identity() * eta.norm_squared() - eta * eta.transpose()) * m;
+    (m, eta.into(), arr3(&rho))
+}
+
+pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initial: &mut State) {
+    let model = lw.model;
+    let starts = &model.dofs.node_start[bi];
+    let ids = &lw.beam_nodes[bi];
+    for (k, &s) in starts.iter().enumerate() {
+        for i in 0..3 {
+            initial.q[s + i] = b.initial_nodes[k][i];
+            initial.v[s + i] = b.velocities[k][i];
+        }
+        initial.rot[ids[k]] = NodeRotation {
+            w: b.angular_velocities[k],
+            ..NodeRotation::REST
+        };
+    }
+    let (m, eta, rho) = section_mass(b);
+    let p = b.order;
+    for e in 0..b.elements {
+        let local: Vec<usize> = (e * (p - 1)..=e * (p - 1) + p - 1).collect();
+        let dofs = local
+            .iter()
+            .flat_map(|&k| starts[k]..starts[k] + 6)
+            .collect();
+        let positions: Vec<[f64; 3]> = local.iter().map(|&k| b.nodes[k]).collect();
+        elements.push(Element::Beam(BeamElement::new(
+            dofs,
+            local.iter().map(|&k| ids[k]).collect(),
+            &positions,
+            vec![b.frame; p],
+            b.section.stiffness,
+            m,
+            eta,
+            rho,
+            model.gravity,
+        )));
+    }
+    // Concentrated masses: rigid bodies on the node, centred there.
+    for &(node, mass, inertia) in &b.point_masses {
+        let s = starts[node];
+        elements.push(Element::RigidBody(RigidBody {
+            dofs: [s, s + 1, s + 2, s + 3, s + 4, s + 5],
+            node: ids[node],
+            mass,
+            eta0: [0.0; 3],
+            inertia0: arr3(&m3(&inertia)),
+            gravity: model.gravity,
+        }));
+    }
+}
+
+/// An output at arc length `s` between the nodes of beam `bi`: the element's shape functions
+/// at that point weight its nodes' translations.
+pub fn between_nodes(
+    lw: &Lower,
+    bi: usize,
+    s: f64,
+    quantity: ProbeQuantity,
+    component: usize,
+) -> Probe {
+    let b = &lw.model.beams[bi];
+    let le = b.length / b.elements as f64;
+    let e = ((s / le).floor() as usize).min(b.elements - 1);
+    let xi = 2.0 * (s - e as f64 * le) / le - 1.0;
+    let p = b.order;
+    let nodes: Vec<f64> = (0..p)
+        .map(|k| -1.0 + 2.0 * k as f64 / (p - 1) as f64)
+        .collect();
+    let mut dofs = Vec::new();
+    let mut weights = Vec::new();
+    for k in 0..p {
+        let w: f64 = (0..p)
+            .filter(|&j| j != k)
+            .map(|j| (xi - nodes[j]) / (nodes[k] - nodes[j]))
+            .product();
+        let st = lw.model.dofs.node_start[bi][e * (p - 1) + k];
+        dofs.push([st, st + 1, st + 2]);
+        weights.push(w);
+    }
+    Probe::Interpolated {
+        dofs,
+        weights,
+        quantity,
+        component,
+    }
+}
