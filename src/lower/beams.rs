@@ -82,19 +82,13 @@ pub fn between_nodes(
     let e = ((s / le).floor() as usize).min(b.elements - 1);
     let xi = 2.0 * (s - e as f64 * le) / le - 1.0;
     let p = b.order;
-    let nodes: Vec<f64> = (0..p)
-        .map(|k| -1.0 + 2.0 * k as f64 / (p - 1) as f64)
-        .collect();
+    let (n, _) = crate::runtime::beams::shape(p, xi);
     let mut dofs = Vec::new();
     let mut weights = Vec::new();
-    for k in 0..p {
-        let w: f64 = (0..p)
-            .filter(|&j| j != k)
-            .map(|j| (xi - nodes[j]) / (nodes[k] - nodes[j]))
-            .product();
+    for (k, w) in n.iter().enumerate().take(p) {
         let st = lw.model.dofs.node_start[bi][e * (p - 1) + k];
         dofs.push([st, st + 1, st + 2]);
-        weights.push(w);
+        weights.push(*w);
     }
     Probe::Interpolated {
         dofs,

@@ -89,7 +89,7 @@ fn gauss(n: usize) -> (&'static [f64], &'static [f64]) {
 }
 
 /// Lagrange shape functions and their derivatives on equally spaced nodes of [-1, 1].
-fn shape(nn: usize, xi: f64) -> ([f64; MAXN], [f64; MAXN]) {
+pub fn shape(nn: usize, xi: f64) -> ([f64; MAXN], [f64; MAXN]) {
     let nodes: Vec<f64> = (0..nn)
         .map(|k| -1.0 + 2.0 * k as f64 / (nn - 1) as f64)
         .collect();
@@ -285,6 +285,18 @@ impl BeamElement {
         Field { t, dx, k, a, da }
     }
 
+    /// Acceleration, angular velocity and angular acceleration interpolated at a point.
+    fn point_rates(&self, st: &State, gp: &Gauss, wn: &[V3], dwn: &[V3]) -> (V3, V3, V3) {
+        let (mut a, mut w, mut dw) = (V3::zeros(), V3::zeros(), V3::zeros());
+        for k in 0..self.len() {
+            let d = &self.dofs[6 * k..6 * k + 3];
+            a += V3::new(st.a[d[0]], st.a[d[1]], st.a[d[2]]) * gp.n[k];
+            w += wn[k] * gp.n[k];
+            dw += dwn[k] * gp.n[k];
+        }
+        (a, w, dw)
+    }
+
     /// Section resultants (inertial) and the strains at an elastic point.
     fn resultants(&self, f: &Field, gp: &Gauss) -> (V3, V3, [f64; 6]) {
         let g = f.t.transpose() * f.dx - V3::x();
@@ -339,13 +351,7 @@ impl BeamElement {
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, false);
             let (meta, rho) = self.inertia(&f.t);
-            let (mut a, mut w, mut dw) = (V3::zeros(), V3::zeros(), V3::zeros());
-            for k in 0..nn {
-                let d = &self.dofs[6 * k..6 * k + 3];
-                a += V3::new(st.a[d[0]], st.a[d[1]], st.a[d[2]]) * gp.n[k];
-                w += wn[k] * gp.n[k];
-                dw += dwn[k] * gp.n[k];
-            }
+            let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
             let (wt, dwt) = (tilde(&w), tilde(&dw));
             let fu = self.mass * a + (dwt + wt * wt) * meta;
             let ft = meta.cross(&a) + rho * dw + w.cross(&(rho * w));
@@ -415,13 +421,7 @@ impl BeamElement {
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, true);
             let (meta, rho) = self.inertia(&f.t);
-            let (mut a, mut w, mut dw) = (V3::zeros(), V3::zeros(), V3::zeros());
-            for k in 0..nn {
-                let d = &self.dofs[6 * k..6 * k + 3];
-                a += V3::new(st.a[d[0]], st.a[d[1]], st.a[d[2]]) * gp.n[k];
-                w += wn[k] * gp.n[k];
-                dw += dwn[k] * gp.n[k];
-            }
+            let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
             let (wt, dwt, at) = (tilde(&w), tilde(&dw), tilde(&a));
             let et = tilde(&meta);
             let (rw, rdw) = (rho * w, rho * dw);

@@ -11,7 +11,7 @@
 //! the integrator (THEORY §1, §7.1).
 
 mod assembly;
-mod beams;
+pub mod beams;
 mod bodies;
 mod elements;
 mod forces;
