@@ -84,19 +84,31 @@ impl Transform {
     /// built from element index lists, which couple whole nodes).
     pub fn new(n: usize, firsts: &[usize], p: &Pattern) -> Option<Transform> {
         let mut first_of = vec![None; n];
+        let rows = |c: usize| &p.row_idx[p.col_ptr[c]..p.col_ptr[c + 1]];
         for (k, &f) in firsts.iter().enumerate() {
             first_of[f] = Some(k);
-            let rows = |c: usize| &p.row_idx[p.col_ptr[c]..p.col_ptr[c + 1]];
             if rows(f) != rows(f + 1) || rows(f) != rows(f + 2) {
                 return None;
             }
-            // Rows f, f+1, f+2 must appear together in every column.
-            for c in 0..p.n {
-                let r = rows(c);
-                if let Ok(i) = r.binary_search(&f) {
-                    if r.get(i + 1) != Some(&(f + 1)) || r.get(i + 2) != Some(&(f + 2)) {
-                        return None;
-                    }
+        }
+        // Rows f, f+1, f+2 must appear together in every column: one pass over the pattern.
+        // `member[r]` is the offset of row r inside its block (0, 1, 2), or 3 outside blocks.
+        let mut member = vec![3u8; n];
+        for &f in firsts {
+            member[f] = 0;
+            member[f + 1] = 1;
+            member[f + 2] = 2;
+        }
+        for c in 0..p.n {
+            let r = rows(c);
+            for (i, &row) in r.iter().enumerate() {
+                let ok = match member[row] {
+                    0 => r.get(i + 1) == Some(&(row + 1)) && r.get(i + 2) == Some(&(row + 2)),
+                    1 | 2 => i > 0 && r[i - 1] + 1 == row,
+                    _ => true,
+                };
+                if !ok {
+                    return None;
                 }
             }
         }
