@@ -14,8 +14,11 @@ use mbd::model::Overrides;
 use std::time::Duration;
 
 fn source() -> String {
-    std::fs::read_to_string(format!("{}/models/rotating_beam.mbd", env!("CARGO_MANIFEST_DIR")))
-        .unwrap_or_default()
+    std::fs::read_to_string(format!(
+        "{}/models/rotating_beam.mbd",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap_or_default()
 }
 
 fn scaling(c: &mut Criterion) {

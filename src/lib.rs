@@ -191,7 +191,7 @@ impl Compiled {
             max_halvings: if s.integrator == model::Integrator::Static {
                 4
             } else {
-                1
+                3
             },
         }
     }

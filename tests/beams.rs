@@ -235,6 +235,29 @@ fn two_bar_beams_agree_with_the_rigid_two_bar() {
 }
 
 #[test]
+fn two_bar_beams_runs_the_papers_case_at_its_step() {
+    // The shipped model as P3 specifies it: 50 s at dt = 0.05 s (bar 2 reaches ~11 rad/s: a
+    // stiff element turning 0.55 rad per step; Newton needs the half-radian limit on its
+    // corrections and halves about one step in eight). Up to 10 s
+    // theta2 stays within 0.2 rad of the rigid model at the same step (measured 0.137 rad;
+    // each is about 0.1 rad from the exact solution at this step, rigid: 0.093 rad in
+    // tests/rigid.rs); after the load reversal the two discrete solutions separate, as any two
+    // discretizations of this motion do at this step.
+    let beams = simulate("models/two_bar_beams.mbd", &[], Overrides::default());
+    let t = beams.col("t");
+    assert!(
+        (t[t.len() - 1] - 50.0).abs() < 1e-9,
+        "ended at {}",
+        t[t.len() - 1]
+    );
+    let rigid = simulate("models/two_bar.mbd", &[], Overrides::default());
+    let (a, b) = (beams.col("theta2"), rigid.col("theta2"));
+    let worst = (0..=200).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max);
+    eprintln!("two_bar_beams dt 0.05: theta2 within {worst:.3e} rad of the rigid model to 10 s");
+    assert!(worst < 0.2, "theta2 {worst}");
+}
+
+#[test]
 fn elastic_two_bar_root_torque_exceeds_the_rigid_one_and_converges() {
     // P4 with elastic bars, over the first 5 s: the peak drive torque against the rigid
     // model's, at two steps and two meshes. Measured: ratio 2.55 (1 ms), 2.54 (0.5 ms), 2.51
