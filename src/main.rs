@@ -101,6 +101,20 @@ enum Command {
         #[arg(long = "set", value_name = "NAME=VALUE")]
         set: Vec<String>,
     },
+    /// Time histories of channels of a run's CSV, as an SVG chart.
+    Plot {
+        /// A CSV written by `mbd run`.
+        csv: String,
+        /// A channel to draw (repeat for several).
+        #[arg(long = "channel", value_name = "NAME", required = true)]
+        channels: Vec<String>,
+        /// Write the SVG here.
+        #[arg(short = 'o', long = "output")]
+        output: String,
+        /// Chart title (default: the CSV's file name).
+        #[arg(long)]
+        title: Option<String>,
+    },
     /// Explain a diagnostic code, e.g. `mbd explain E0202`.
     Explain { code: String },
 }
@@ -169,6 +183,12 @@ fn main() -> ExitCode {
             emit,
             set,
         } => check(&model, format, emit, &set),
+        Command::Plot {
+            csv,
+            channels,
+            output,
+            title,
+        } => plot(&csv, &channels, &output, title.as_deref()),
         Command::Modes {
             model,
             output,
@@ -246,6 +266,35 @@ fn main() -> ExitCode {
             };
             run(&model, output.as_deref(), &set, overrides, format)
         }
+    }
+}
+
+/// `mbd plot`: exit 0, or 2 for an unreadable CSV, an unknown channel or an unwritable file.
+fn plot(path: &str, channels: &[String], output: &str, title: Option<&str>) -> ExitCode {
+    let text = match std::fs::read_to_string(path) {
+        Ok(t) => t,
+        Err(e) => return usage(&format!("cannot read CSV file `{path}`: {e}")),
+    };
+    let (header, rows) = match mbd::output::read_csv(&text) {
+        Ok(t) => t,
+        Err(e) => return usage(&format!("`{path}` is not a CSV written by `mbd run`: {e}")),
+    };
+    let name = std::path::Path::new(path)
+        .file_name()
+        .map(|n| n.to_string_lossy().to_string())
+        .unwrap_or_else(|| path.to_string());
+    let chart =
+        match mbd::output::charts::time_history(title.unwrap_or(&name), &header, &rows, channels) {
+            Ok(c) => c,
+            Err(e) => return usage(&e),
+        };
+    let svg = match mbd::output::charts::render(&chart) {
+        Ok(s) => s,
+        Err(e) => return usage(&format!("cannot draw the chart: {e}")),
+    };
+    match std::fs::write(output, svg) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => usage(&format!("cannot create output file `{output}`: {e}")),
     }
 }
 

@@ -259,3 +259,59 @@ fn explain_prints_a_codes_documentation() {
     assert_eq!(code(&o), 0);
     assert!(String::from_utf8_lossy(&o.stdout).contains("unit mismatch"));
 }
+
+#[test]
+fn plot_draws_the_named_channels_of_a_run() {
+    let run_csv = temp("plot_run.csv", "");
+    let o = mbd(&[
+        "run",
+        "models/pendulum.mbd",
+        "--until",
+        "0.5",
+        "-o",
+        run_csv.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let svg = temp("plot.svg", "");
+    let o = mbd(&[
+        "plot",
+        run_csv.to_str().unwrap_or_default(),
+        "--channel",
+        "x",
+        "--channel",
+        "tension",
+        "-o",
+        svg.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&svg).unwrap_or_default();
+    assert!(text.starts_with("<svg"), "not an SVG");
+    // One line per channel in its own colour (and its legend mark), the time axis labelled.
+    for colour in ["#1F77B4", "#FF7F0E"] {
+        assert!(
+            text.contains(&format!(
+                "<polyline fill=\"none\" opacity=\"1\" stroke=\"{colour}\""
+            )),
+            "no line in {colour}"
+        );
+    }
+    for label in ["tension", "t [s]", "plot_run.csv"] {
+        assert!(text.contains(label), "missing `{label}`");
+    }
+    // An unknown channel is a usage error naming the channels the CSV has.
+    let o = mbd(&[
+        "plot",
+        run_csv.to_str().unwrap_or_default(),
+        "--channel",
+        "tensoin",
+        "-o",
+        svg.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(code(&o), 2);
+    assert!(
+        stderr(&o).contains("no channel `tensoin`"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("tension"), "{}", stderr(&o));
+}

@@ -4,6 +4,8 @@
 //! as the model names them), one row per written step, SI values at full round-trip precision.
 //! Rows are written as they come, so a failed run keeps every row computed before the failure.
 
+pub mod charts;
+
 use crate::runtime::{Augment, State, System};
 use std::io::{self, Write};
 

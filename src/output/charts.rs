@@ -1,0 +1,218 @@
+//! SVG charts (plotters, SVG backend only: no fonts or native libraries): time histories of a
+//! run (`mbd plot`), and log-log charts of error against cost.
+//!
+//! Contract: a chart is one SVG document with a title, labelled axes, one line per series and a
+//! legend; non-finite points are skipped (a run that failed keeps the rows written so far, and
+//! the chart shows them); on log axes non-positive values are skipped.
+
+use plotters::prelude::*;
+
+/// One line of a chart.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Series {
+    pub label: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// What to draw.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Chart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub log_x: bool,
+    pub log_y: bool,
+    pub series: Vec<Series>,
+}
+
+/// Distinct line colours (Tableau 10).
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// The range of the finite (positive, on a log axis) values, widened when degenerate.
+fn range(values: impl Iterator<Item = f64>, log: bool) -> Option<(f64, f64)> {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for v in values {
+        if v.is_finite() && (!log || v > 0.0) {
+            lo = lo.min(v);
+            hi = hi.max(v);
+        }
+    }
+    if lo > hi {
+        return None;
+    }
+    if log {
+        if hi <= lo * (1.0 + 1e-12) {
+            return Some((lo / 2.0, hi * 2.0));
+        }
+        return Some((lo, hi));
+    }
+    if hi - lo <= 1e-12 * hi.abs().max(lo.abs()).max(1e-300) {
+        let pad = if lo == 0.0 { 1.0 } else { 0.1 * lo.abs() };
+        return Some((lo - pad, hi + pad));
+    }
+    let pad = 0.05 * (hi - lo);
+    Some((lo - pad, hi + pad))
+}
+
+fn kept(p: &(f64, f64), log_x: bool, log_y: bool) -> bool {
+    p.0.is_finite() && p.1.is_finite() && (!log_x || p.0 > 0.0) && (!log_y || p.1 > 0.0)
+}
+
+/// Renders a chart as an SVG document (800 x 500).
+pub fn render(chart: &Chart) -> Result<String, String> {
+    let (lx, ly) = (chart.log_x, chart.log_y);
+    let pts = || {
+        chart
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(move |p| kept(p, lx, ly))
+    };
+    let (x0, x1) = range(pts().map(|p| p.0), lx).ok_or("nothing to plot: no finite points")?;
+    let (y0, y1) = range(pts().map(|p| p.1), ly).ok_or("nothing to plot: no finite points")?;
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, 500)).into_drawing_area();
+        let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let mut builder = ChartBuilder::on(&root);
+        builder
+            .caption(&chart.title, ("sans-serif", 20))
+            .margin(12)
+            .x_label_area_size(42)
+            .y_label_area_size(72);
+        // The four axis kinds are four coordinate types; one macro draws each.
+        macro_rules! draw {
+            ($xr:expr, $yr:expr) => {{
+                let mut c = builder.build_cartesian_2d($xr, $yr).map_err(e)?;
+                c.configure_mesh()
+                    .x_desc(chart.x_label.as_str())
+                    .y_desc(chart.y_label.as_str())
+                    .draw()
+                    .map_err(e)?;
+                for (k, s) in chart.series.iter().enumerate() {
+                    let colour = PALETTE[k % PALETTE.len()];
+                    let points: Vec<(f64, f64)> = s
+                        .points
+                        .iter()
+                        .copied()
+                        .filter(|p| kept(p, lx, ly))
+                        .collect();
+                    let style = colour.stroke_width(2);
+                    c.draw_series(LineSeries::new(points.iter().copied(), style))
+                        .map_err(e)?
+                        .label(s.label.as_str())
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 20, y)], colour.stroke_width(2))
+                        });
+                    // Markers where a series has few points (study charts).
+                    if points.len() <= 40 {
+                        c.draw_series(points.iter().map(|&p| Circle::new(p, 3, colour.filled())))
+                            .map_err(e)?;
+                    }
+                }
+                c.configure_series_labels()
+                    .background_style(WHITE.mix(0.85))
+                    .border_style(BLACK)
+                    .draw()
+                    .map_err(e)?;
+            }};
+        }
+        match (lx, ly) {
+            (false, false) => draw!(x0..x1, y0..y1),
+            (true, false) => draw!((x0..x1).log_scale(), y0..y1),
+            (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
+            (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
+        }
+        root.present().map_err(e)?;
+    }
+    Ok(svg)
+}
+
+/// Time histories of the named channels of a run's CSV (header `t`, then channels).
+pub fn time_history(
+    title: &str,
+    header: &[String],
+    rows: &[Vec<f64>],
+    channels: &[String],
+) -> Result<Chart, String> {
+    let t = header
+        .iter()
+        .position(|h| h == "t")
+        .ok_or("the CSV has no `t` column")?;
+    let mut series = Vec::new();
+    for name in channels {
+        let Some(k) = header.iter().position(|h| h == name) else {
+            let known: Vec<&str> = header
+                .iter()
+                .filter(|h| h.as_str() != "t")
+                .map(String::as_str)
+                .collect();
+            return Err(format!(
+                "no channel `{name}` in the CSV; its channels are: {}",
+                known.join(", ")
+            ));
+        };
+        series.push(Series {
+            label: name.clone(),
+            points: rows.iter().map(|r| (r[t], r[k])).collect(),
+        });
+    }
+    Ok(Chart {
+        title: title.to_string(),
+        x_label: "t [s]".to_string(),
+        y_label: if channels.len() == 1 {
+            channels[0].clone()
+        } else {
+            "value (SI)".to_string()
+        },
+        log_x: false,
+        log_y: false,
+        series,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chart(points: Vec<(f64, f64)>, log: bool) -> Chart {
+        Chart {
+            title: "t".into(),
+            x_label: "x".into(),
+            y_label: "y".into(),
+            log_x: log,
+            log_y: log,
+            series: vec![Series {
+                label: "s".into(),
+                points,
+            }],
+        }
+    }
+
+    #[test]
+    fn renders_lines_and_skips_non_finite_points() {
+        let svg = render(&chart(vec![(0.0, 1.0), (1.0, f64::NAN), (2.0, 3.0)], false));
+        let svg = svg.unwrap_or_default();
+        assert!(svg.starts_with("<svg"));
+        assert!(svg.contains("<polyline"));
+    }
+
+    #[test]
+    fn log_axes_skip_non_positive_values_and_empty_charts_are_errors() {
+        assert!(render(&chart(vec![(1.0, 1e-3), (10.0, 1e-6), (0.0, 1.0)], true)).is_ok());
+        assert!(render(&chart(vec![(0.0, 0.0)], true)).is_err());
+        assert!(render(&chart(vec![(1.0, 2.0)], false)).is_ok());
+    }
+}
