@@ -298,6 +298,26 @@ fn plot(path: &str, channels: &[String], output: &str, title: Option<&str>) -> E
     }
 }
 
+/// Compiles a model, reporting its warnings; on errors, reports them and gives exit code 1.
+fn compile(
+    path: &str,
+    text: &str,
+    sets: &[String],
+    overrides: Overrides,
+    format: Format,
+) -> Result<mbd::Compiled, ExitCode> {
+    match mbd::compile_with(path, text, sets, overrides, &FsLoader::new()) {
+        Ok(c) => {
+            report(&c.warnings, &c.sources, format);
+            Ok(c)
+        }
+        Err(f) => {
+            report(&f.diagnostics, &f.sources, format);
+            Err(ExitCode::from(EXIT_MODEL))
+        }
+    }
+}
+
 fn usage(msg: &str) -> ExitCode {
     eprintln!("error: {msg}");
     ExitCode::from(EXIT_USAGE)
@@ -354,14 +374,10 @@ fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> Exi
             }
         };
     }
-    let c = match mbd::compile_with(path, &text, sets, Overrides::default(), &FsLoader::new()) {
+    let c = match compile(path, &text, sets, Overrides::default(), format) {
         Ok(c) => c,
-        Err(f) => {
-            report(&f.diagnostics, &f.sources, format);
-            return ExitCode::from(EXIT_MODEL);
-        }
+        Err(code) => return code,
     };
-    report(&c.warnings, &c.sources, format);
     let json = |v: Result<String, serde_json::Error>| {
         v.unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
     };
@@ -478,14 +494,10 @@ fn modes(
         Ok(t) => t,
         Err(code) => return code,
     };
-    let c = match mbd::compile_with(path, &text, sets, Overrides::default(), &FsLoader::new()) {
+    let c = match compile(path, &text, sets, Overrides::default(), format) {
         Ok(c) => c,
-        Err(f) => {
-            report(&f.diagnostics, &f.sources, format);
-            return ExitCode::from(EXIT_MODEL);
-        }
+        Err(code) => return code,
     };
-    report(&c.warnings, &c.sources, format);
     let m = match mbd::modes(&c) {
         Ok(m) => m,
         Err(d) => {
@@ -549,14 +561,10 @@ fn run(
         Ok(t) => t,
         Err(code) => return code,
     };
-    let c = match mbd::compile_with(path, &text, sets, overrides, &FsLoader::new()) {
+    let c = match compile(path, &text, sets, overrides, format) {
         Ok(c) => c,
-        Err(f) => {
-            report(&f.diagnostics, &f.sources, format);
-            return ExitCode::from(EXIT_MODEL);
-        }
+        Err(code) => return code,
     };
-    report(&c.warnings, &c.sources, format);
     if let Err(d) = &c.lowered {
         report(std::slice::from_ref(d), &c.sources, format);
         return ExitCode::from(EXIT_MODEL);
