@@ -199,10 +199,11 @@ impl Compiled {
     /// A runtime failure as a diagnostic pointing at the entity's declaration.
     pub fn failure_diagnostic(&self, f: &RuntimeFailure) -> Diagnostic {
         let (code, what, hint) = match f.kind {
+            FailureKind::NewtonDiverged if self.settings().method == Method::Fet => (Code::E0601, "Newton iteration failed", "time finite elements have no numerical dissipation, and the midpoint rule is not stable for stiff beams in large motion (THEORY §8.2): use `--integrator hht` (alpha -0.1), or try a smaller time step (--dt)"),
             FailureKind::NewtonDiverged => (Code::E0601, "Newton iteration failed", "try a smaller time step (--dt), more numerical dissipation (--alpha -0.3), or check for a load or motion that is discontinuous or too large"),
             FailureKind::Singular => (Code::E0602, "singular iteration matrix", "check that every body has a positive mass and that no two joints constrain the same motion"),
             FailureKind::NonFinite => (Code::E0603, "non-finite values", "try a smaller time step (--dt); check params for extreme values"),
-            FailureKind::Unsupported => (Code::E0604, "integrator not available", "use `--integrator hht` or `--integrator generalized-alpha`"),
+            FailureKind::Unsupported => (Code::E0604, "integrator not available", "time finite elements integrate rotations incrementally: drop `--rotations conformal`, or use `--integrator hht` for the conformal treatment"),
         };
         let Ok(l) = &self.lowered else {
             return Diagnostic::error(code, what.to_string()).hint(hint);
@@ -283,13 +284,13 @@ pub fn run_with_progress(
         warnings: Vec::new(),
         rows,
     };
-    if set.method == Method::Fet {
+    if set.method == Method::Fet && set.rotation == RotationTreatment::Conformal {
         let f = RuntimeFailure {
             kind: FailureKind::Unsupported,
             t: 0.0,
             step: 0,
             entity: None,
-            detail: "time finite elements (fet) are not available in this version".to_string(),
+            detail: "time finite elements with the conformal rotation treatment".to_string(),
         };
         return Err(RunFailure {
             diagnostic: c.failure_diagnostic(&f),

@@ -186,7 +186,14 @@ fn runtime_failure_exits_3_says_when_and_where_and_keeps_the_rows() {
         mbd::output::read_csv(&std::fs::read_to_string(&out).expect("csv")).expect("parse");
     assert_eq!(header[0], "t");
     assert_eq!(rows.len(), 1, "the initial row is kept");
-    let o = mbd(&["run", "models/pendulum.mbd", "--integrator", "fet"]);
+    let o = mbd(&[
+        "run",
+        "models/pendulum.mbd",
+        "--integrator",
+        "fet",
+        "--rotations",
+        "conformal",
+    ]);
     assert_eq!(code(&o), 3);
     assert!(stderr(&o).contains("E0604"), "{}", stderr(&o));
 }

@@ -290,6 +290,7 @@ fn runtime_diagnostics_name_when_and_where() {
     };
     let fet = Overrides {
         integrator: Some(mbd::model::Integrator::Fet),
+        rotations: Some(mbd::model::Rotations::Conformal),
         ..Default::default()
     };
     let cases = [
@@ -302,7 +303,12 @@ fn runtime_diagnostics_name_when_and_where() {
             Overrides::default(),
             Code::E0601,
         ),
-        ("run_fet_unavailable", pendulum.clone(), fet, Code::E0604),
+        (
+            "run_fet_conformal_unavailable",
+            pendulum.clone(),
+            fet,
+            Code::E0604,
+        ),
         (
             "run_non_finite",
             pendulum.replacen("param V0 = 1.5 m/s", "param V0 = 1e150 m/s", 1),

@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod diagnostics;
 mod docs;
+mod fet;
 mod grammar;
 mod models;
 mod pendulum;

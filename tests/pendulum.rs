@@ -12,14 +12,14 @@ const M: f64 = 1.0;
 const E: f64 = 0.1;
 
 /// The reference pendulum: angle from the bottom, positive towards +x.
-struct Reference {
+pub(crate) struct Reference {
     theta: Vec<f64>,
     omega: Vec<f64>,
 }
 
 impl Reference {
     /// Angle and rate at t = k * dt, k = 0..=steps.
-    fn new(v0: f64, dt: f64, steps: usize) -> Reference {
+    pub(crate) fn new(v0: f64, dt: f64, steps: usize) -> Reference {
         let sub = (dt / 1e-5).ceil() as usize;
         let h = dt / sub as f64;
         let f = |y: [f64; 2]| [y[1], -(G / L) * y[0].sin()];
@@ -78,7 +78,7 @@ fn position_error(trace: &Trace, r: &Reference) -> f64 {
         .fold(0.0, f64::max)
 }
 
-fn final_error(trace: &Trace, r: &Reference) -> f64 {
+pub(crate) fn final_error(trace: &Trace, r: &Reference) -> f64 {
     let (x, y) = (trace.col("x"), trace.col("y"));
     let k = x.len() - 1;
     let (xr, yr) = r.position(k);
@@ -181,7 +181,7 @@ fn position_converges_at_second_order() {
 /// Amplitude of the step-to-step oscillation of a signal over steps `range`: the largest fourth
 /// difference divided by 16, which is exactly `A` for a sawtooth `A (-1)^k` and only
 /// `h^4 |y^(4)| / 16` (about 1e-7 m/s^2 here) for the smooth motion.
-fn sawtooth(y: &[f64], range: std::ops::Range<usize>) -> f64 {
+pub(crate) fn sawtooth(y: &[f64], range: std::ops::Range<usize>) -> f64 {
     range
         .map(|k| (y[k - 2] - 4.0 * y[k - 1] + 6.0 * y[k] - 4.0 * y[k + 1] + y[k + 2]).abs() / 16.0)
         .fold(0.0, f64::max)

@@ -10,7 +10,7 @@ use mbd::model::{Overrides, Rotations};
 use mbd::solve::RunStats;
 use std::f64::consts::PI;
 
-type M = [[f64; 3]; 3];
+pub(crate) type M = [[f64; 3]; 3];
 
 fn mat_t_mul(a: &M, b: &M) -> M {
     let mut c = [[0.0; 3]; 3];
@@ -23,14 +23,14 @@ fn mat_t_mul(a: &M, b: &M) -> M {
 }
 
 /// Geodesic angle between two rotation matrices.
-fn angle_between(a: &M, b: &M) -> f64 {
+pub(crate) fn angle_between(a: &M, b: &M) -> f64 {
     let r = mat_t_mul(a, b);
     ((r[0][0] + r[1][1] + r[2][2] - 1.0) / 2.0)
         .clamp(-1.0, 1.0)
         .acos()
 }
 
-fn overrides(dt: f64, until: f64) -> Overrides {
+pub(crate) fn overrides(dt: f64, until: f64) -> Overrides {
     Overrides {
         dt: Some(dt),
         until: Some(until),
@@ -38,11 +38,11 @@ fn overrides(dt: f64, until: f64) -> Overrides {
     }
 }
 
-fn order(e_coarse: f64, e_fine: f64) -> f64 {
+pub(crate) fn order(e_coarse: f64, e_fine: f64) -> f64 {
     (e_coarse / e_fine).log2()
 }
 
-const FREE_BODY: &str = "model free_body
+pub(crate) const FREE_BODY: &str = "model free_body
 rigid b { mass = 2 kg, inertia = (1, 2, 3) kg*m^2, angular_velocity = (0.3, 1.0, 0.8) rad/s }
 output b.rotation, b.angular_velocity, total_energy
 solve hht(alpha = -0.1) { dt = 0.01 s, until = 10 s }
@@ -110,7 +110,7 @@ fn free_asymmetric_body_follows_eulers_equations() {
 }
 
 /// The model's bar-2 centre-of-mass channels against the reference at sample `k`.
-fn com_error(tr: &Trace, k: usize, s: &TwoBarState) -> f64 {
+pub(crate) fn com_error(tr: &Trace, k: usize, s: &TwoBarState) -> f64 {
     let x = ["xc2", "yc2", "zc2"].map(|c| tr.col(c)[k]);
     (0..3).map(|i| (x[i] - s.xc[i]).powi(2)).sum::<f64>().sqrt()
 }
@@ -119,7 +119,7 @@ fn times(tr: &Trace) -> Vec<f64> {
     tr.col("t")
 }
 
-fn two_bar(dt: f64, until: f64, extra: Overrides) -> Result<Trace, (Trace, String)> {
+pub(crate) fn two_bar(dt: f64, until: f64, extra: Overrides) -> Result<Trace, (Trace, String)> {
     let text = read("models/two_bar.mbd");
     simulate_text(
         "models/two_bar.mbd",

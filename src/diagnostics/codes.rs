@@ -194,7 +194,9 @@ some direction, or constraints may be redundant.";
     E0603 = "E0603", "non-finite values",
         "A NaN or infinity appeared in the solution. The report names where it first appeared.";
     E0604 = "E0604", "integrator not available",
-        "The requested time integrator is not available in this version of mbd. Use `hht`.";
+        "The requested combination of time integrator and options is not available: time finite \
+elements (`fet`) integrate rotations incrementally, so `rotations = conformal` applies to the \
+Newmark family (`hht`, `generalized_alpha`) only.";
     W0201 = "W0201", "unused param",
         "A param is declared but nothing uses it, not even an output. Remove it, or use it.";
     W0202 = "W0202", "unused declaration",

@@ -3,7 +3,7 @@
 //! Invariant: the compressed-column pattern and every element's scatter map are computed at
 //! setup; assembling a Newton matrix writes values in place and allocates nothing.
 
-use super::{Augment, Element, Rate, Residual, State, System, TangentCoeffs};
+use super::{Augment, Element, Rate, Residual, State, System, TangentCoeffs, UnknownKind};
 
 /// A square compressed-column sparsity pattern (sorted row indices per column).
 #[derive(Clone, Debug, PartialEq)]
@@ -57,8 +57,14 @@ pub struct Assembler {
     pub values: Vec<f64>,
     /// Per element: for local entry `i * nl + j` (row-major), the value slot.
     maps: Vec<Vec<usize>>,
+    /// Per element: its unknowns (`Element::indices`), kept to assemble without allocating.
+    indices: Vec<Vec<usize>>,
     local: Vec<f64>,
+    local2: Vec<f64>,
     pub residual: Residual,
+    /// Generalized momenta `P = M(q) V` and transport terms `G` (`dP/dt + G = F^I`).
+    pub momentum: Vec<f64>,
+    pub transport: Vec<f64>,
 }
 
 impl Assembler {
@@ -66,9 +72,11 @@ impl Assembler {
         let n = sys.len();
         let pattern = Pattern::of(n, &sys.elements);
         let mut maps = Vec::with_capacity(sys.elements.len());
+        let mut indices = Vec::with_capacity(sys.elements.len());
         let mut largest = 0;
         for e in &sys.elements {
             let idx = e.indices();
+            indices.push(idx.clone());
             largest = largest.max(idx.len());
             let mut m = Vec::with_capacity(idx.len() * idx.len());
             for &i in &idx {
@@ -84,8 +92,12 @@ impl Assembler {
             pattern,
             values,
             maps,
+            indices,
             local: vec![0.0; largest * largest],
+            local2: vec![0.0; largest * largest],
             residual: Residual::new(n),
+            momentum: vec![0.0; n],
+            transport: vec![0.0; n],
         }
     }
 
@@ -94,6 +106,25 @@ impl Assembler {
         self.residual.clear();
         for e in &sys.elements {
             e.residual(st, aug, &mut self.residual);
+        }
+    }
+
+    /// Evaluates the generalized momenta and transport terms at a state.
+    pub fn momentum(&mut self, sys: &System, st: &State) {
+        self.momentum.iter_mut().for_each(|x| *x = 0.0);
+        self.transport.iter_mut().for_each(|x| *x = 0.0);
+        for e in &sys.elements {
+            e.momentum(st, &mut self.momentum, &mut self.transport);
+        }
+    }
+
+    /// Evaluates the joints' residual parts alone into `out` (cleared first).
+    pub fn joint_residual(&self, sys: &System, st: &State, aug: Augment, out: &mut Residual) {
+        out.clear();
+        for e in &sys.elements {
+            if let Element::Joint(j) = e {
+                j.residual(st, aug, out);
+            }
         }
     }
 
@@ -111,6 +142,58 @@ impl Assembler {
         for (e, map) in sys.elements.iter().zip(&self.maps) {
             let nl2 = map.len();
             e.tangent(st, aug, c, &mut self.local[..nl2]);
+            for (slot, v) in map.iter().zip(&self.local[..nl2]) {
+                if let Some(x) = self.values.get_mut(*slot) {
+                    *x += v;
+                }
+            }
+        }
+    }
+
+    /// An iteration matrix over two configurations (time finite elements, THEORY §8.1): every
+    /// element at `mid` with coefficients `c`, except the joints' position-level constraint rows
+    /// and their penalty, which come from `end` with unit position weight (for a scheme that
+    /// enforces the constraints at `end`; `aug_end` carries the penalty, `end.lambda` must be
+    /// zero and `aug_mid.p` zero).
+    pub fn tangent_split(
+        &mut self,
+        sys: &System,
+        mid: &State,
+        end: &State,
+        aug_mid: Augment,
+        aug_end: Augment,
+        c: TangentCoeffs,
+    ) {
+        self.values.iter_mut().for_each(|x| *x = 0.0);
+        let at_end = TangentCoeffs {
+            mass: 0.0,
+            velocity: 0.0,
+            position: 1.0,
+            force_weight: c.force_weight,
+        };
+        for ((e, map), idx) in sys.elements.iter().zip(&self.maps).zip(&self.indices) {
+            let nl2 = map.len();
+            e.tangent(mid, aug_mid, c, &mut self.local[..nl2]);
+            if let Element::Joint(_) = e {
+                e.tangent(end, aug_end, at_end, &mut self.local2[..nl2]);
+                let nl = idx.len();
+                for (li, &gi) in idx.iter().enumerate() {
+                    let row = li * nl..(li + 1) * nl;
+                    match sys.unknowns[gi] {
+                        UnknownKind::Multiplier => {
+                            self.local[row.clone()].copy_from_slice(&self.local2[row]);
+                        }
+                        UnknownKind::RateMultiplier => {}
+                        _ => {
+                            for (lj, &gj) in idx.iter().enumerate() {
+                                if !sys.unknowns[gj].is_multiplier() {
+                                    self.local[li * nl + lj] += self.local2[li * nl + lj];
+                                }
+                            }
+                        }
+                    }
+                }
+            }
             for (slot, v) in map.iter().zip(&self.local[..nl2]) {
                 if let Some(x) = self.values.get_mut(*slot) {
                     *x += v;

@@ -450,6 +450,39 @@ impl BeamElement {
         }
     }
 
+    /// Adds the nodal momenta `int N (h, g) ds`, with `h = m (v + w x eta)` and
+    /// `g = rho w + m eta x v`, and the transport term `int N (0, v x h) ds` (THEORY §8.1),
+    /// at the inertial points.
+    pub fn momentum(&self, st: &State, p: &mut [f64], tr: &mut [f64]) {
+        let nn = self.len();
+        let x = self.positions(&st.q);
+        let vn = self.positions(&st.v);
+        let t = self.triads_at(st);
+        let rel = self.relative_from(&t);
+        let (wn, _) = self.rates(st);
+        for gp in &self.inertial {
+            let f = self.field(&rel, &x, gp, false);
+            let (meta, rho) = self.inertia(&f.t);
+            let (mut v, mut w) = (V3::zeros(), V3::zeros());
+            for k in 0..nn {
+                v += vn[k] * gp.n[k];
+                w += wn[k] * gp.n[k];
+            }
+            let h = self.mass * v + w.cross(&meta);
+            let g = rho * w + meta.cross(&v);
+            let gt = v.cross(&h);
+            for k in 0..nn {
+                let d = &self.dofs[6 * k..6 * k + 6];
+                let c = gp.wj * gp.n[k];
+                for i in 0..3 {
+                    p[d[i]] += c * h[i];
+                    p[d[3 + i]] += c * g[i];
+                    tr[d[3 + i]] += c * gt[i];
+                }
+            }
+        }
+    }
+
     /// Kinetic energy, and potential energy: elastic plus gravity.
     pub fn energy(&self, st: &State) -> Energy {
         let nn = self.len();

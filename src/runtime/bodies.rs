@@ -32,6 +32,13 @@ impl PointMass {
         }
     }
 
+    /// Adds the momentum `m v` (THEORY §8.1); a point mass has no transport term.
+    pub fn momentum(&self, st: &State, p: &mut [f64]) {
+        for &d in &self.dofs {
+            p[d] += self.mass * st.v[d];
+        }
+    }
+
     pub fn energy(&self, st: &State) -> Energy {
         let v = V3::from(self.dofs.map(|i| st.v[i]));
         let x = V3::from(self.dofs.map(|i| st.q[i]));
@@ -130,6 +137,26 @@ impl RigidBody {
         k[..36].iter_mut().for_each(|x| *x = 0.0);
         for (r0, c0, b) in blocks {
             add_block(k, 6, r0, c0, &b);
+        }
+    }
+
+    /// Adds the momenta `(m v + w x m eta, J w + m eta x v)` and the transport term
+    /// `(0, v x (w x m eta))` (THEORY §8.1): their rate plus the transport term is `F^I`.
+    pub fn momentum(&self, st: &State, p: &mut [f64], g: &mut [f64]) {
+        let n = &st.rot[self.node];
+        let r = n.matrix();
+        let w = n.omega();
+        let v = V3::new(st.v[self.dofs[0]], st.v[self.dofs[1]], st.v[self.dofs[2]]);
+        let meta = r * V3::from(self.eta0) * self.mass;
+        let j = r * m3(&self.inertia0) * r.transpose();
+        let wm = w.cross(&meta);
+        let pu = self.mass * v + wm;
+        let pt = j * w + meta.cross(&v);
+        let gt = v.cross(&wm);
+        for i in 0..3 {
+            p[self.dofs[i]] += pu[i];
+            p[self.dofs[3 + i]] += pt[i];
+            g[self.dofs[3 + i]] += gt[i];
         }
     }
 

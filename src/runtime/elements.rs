@@ -66,6 +66,17 @@ impl Element {
         }
     }
 
+    /// Adds this element's generalized momenta `P = M(q) V` and transport term `G` (THEORY
+    /// §8.1): `dP/dt + G = F^I`. Elements without inertia add nothing.
+    pub fn momentum(&self, st: &State, p: &mut [f64], g: &mut [f64]) {
+        match self {
+            Element::PointMass(m) => m.momentum(st, p),
+            Element::RigidBody(b) => b.momentum(st, p, g),
+            Element::Beam(b) => b.momentum(st, p, g),
+            Element::Joint(_) | Element::Spring(_) | Element::Load(_) => {}
+        }
+    }
+
     /// Writes a time derivative of the constraints into `out` at multiplier rows.
     pub fn constraint_rate(&self, st: &State, rate: Rate, out: &mut [f64]) {
         if let Element::Joint(j) = self {

@@ -192,7 +192,8 @@ impl NodeRotation {
 /// The state at one instant. `q`, `v`, `a` have one entry per unknown: positions, velocities
 /// and accelerations of coordinates; for rotation unknowns, whatever the integrator's
 /// rotation treatment keeps there (the rotating nodes' kinematics are in `rot`). `lambda`
-/// is used only at multipliers. `alg` holds generalized-alpha's algorithmic accelerations.
+/// is used only at multipliers. `alg` holds generalized-alpha's algorithmic accelerations, or the
+/// nodal momenta of time finite elements.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct State {
     pub t: f64,

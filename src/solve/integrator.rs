@@ -15,7 +15,11 @@
 //! body-frame increments ([`super::se3`]); with the conformal treatment the rotation unknowns
 //! hold `c`, `c-dot`, `c-ddot` like any coordinate ([`super::rotations`]).
 
+#[path = "fet.rs"]
+mod fet;
+
 use super::linear::{LinearError, SparseLu};
+use super::newton::Newton;
 use super::rotations::{self, Transform};
 use super::se3;
 use super::{
@@ -23,7 +27,9 @@ use super::{
     StartMode,
 };
 use crate::runtime::rotation::{self as rot, M3, V3};
-use crate::runtime::{Assembler, Augment, Rate, State, System, TangentCoeffs, UnknownKind};
+use crate::runtime::{
+    Assembler, Augment, Rate, Residual, State, System, TangentCoeffs, UnknownKind,
+};
 
 /// The scheme's constants.
 #[derive(Clone, Copy, Debug)]
@@ -51,6 +57,15 @@ impl Scheme {
                     stat: false,
                 }
             }
+            // Time finite elements: the trapezoidal constants size the constraint scaling
+            // (`s = 4 m / h^2 + k`) and the start.
+            Method::Fet => Scheme {
+                am: 0.0,
+                af: 0.0,
+                beta: 0.25,
+                gamma: 0.5,
+                stat: false,
+            },
             // HHT in the Arnold-Bruls form: equations at t_{n+1}, a_m = 0, a_f = -alpha. Same
             // linear amplification as the force-weighted form, and second order with
             // configuration-dependent inertia (the weighted form is first order there).
@@ -78,6 +93,13 @@ pub struct Integrator<'s> {
     set: Settings,
     sc: Scheme,
     conformal: bool,
+    /// Time finite elements (THEORY §8) instead of the Newmark family: the state is kept in
+    /// the physical layout, `alg` holds the nodal momenta `P`.
+    fet: bool,
+    /// FET: the mid-configuration of the step (constant velocities, the multipliers).
+    mid: State,
+    /// FET: the joints' residual at the end configuration.
+    end_res: Residual,
     asm: Assembler,
     lu: SparseLu,
     /// `T^T J T` on the blocks: rotation unknowns with `H(c)` (conformal), or translation and
@@ -127,7 +149,9 @@ impl<'s> Integrator<'s> {
         };
         let lu = SparseLu::new(&asm.pattern)
             .map_err(|e| setup(format!("the sparse LU could not be set up ({e:?})")))?;
-        let conformal = set.rotation == RotationTreatment::Conformal;
+        let fet = set.method == Method::Fet;
+        // FET integrates rotations incrementally (THEORY §8.1) whatever the treatment.
+        let conformal = set.rotation == RotationTreatment::Conformal && !fet;
         let n = sys.len();
         // Transformed 3x3 blocks and the rotating node of each.
         let nodes = sys.rotations.len();
@@ -144,7 +168,7 @@ impl<'s> Integrator<'s> {
             setup("internal: a rotating node's unknowns are not coupled as a block".into())
         })?;
         let mut in_frame = vec![false; n];
-        if !conformal {
+        if !conformal && !fet {
             for &f in &blocks {
                 in_frame[f..f + 3].iter_mut().for_each(|x| *x = true);
             }
@@ -154,6 +178,9 @@ impl<'s> Integrator<'s> {
             set: set.clone(),
             sc: Scheme::of(set),
             conformal,
+            fet,
+            mid: sys.initial.clone(),
+            end_res: Residual::new(n),
             asm,
             lu,
             transform,
@@ -206,7 +233,12 @@ impl<'s> Integrator<'s> {
         Augment {
             s: k,
             p: k,
-            rate_scale: self.sc.beta * h / self.sc.gamma,
+            // FET: the constant velocity of the element moves by 1/h per unit correction.
+            rate_scale: if self.fet {
+                h
+            } else {
+                self.sc.beta * h / self.sc.gamma
+            },
         }
     }
 
@@ -465,10 +497,21 @@ impl<'s> Integrator<'s> {
 
     /// From the physical layout to the treatment's, and the initial state becomes current.
     fn finish_initialization(&mut self, notices: Vec<Notice>) -> Result<Vec<Notice>, StepFailure> {
-        self.trial.alg.clone_from(&self.trial.a);
-        if self.conformal {
+        if self.fet {
+            // The nodal momenta P_0 = M(q_0) V_0.
+            self.asm.momentum(self.sys, &self.trial);
+            for (i, x) in self.trial.alg.iter_mut().enumerate() {
+                *x = if self.sys.unknowns[i].is_multiplier() {
+                    0.0
+                } else {
+                    self.asm.momentum[i]
+                };
+            }
+        } else if self.conformal {
+            self.trial.alg.clone_from(&self.trial.a);
             rotations::to_conformal(self.sys, &mut self.trial);
         } else {
+            self.trial.alg.clone_from(&self.trial.a);
             se3::to_frames(self.sys, &mut self.trial);
         }
         std::mem::swap(&mut self.cur, &mut self.trial);
@@ -535,6 +578,21 @@ impl<'s> Integrator<'s> {
                     }
                 }
             }
+        }
+    }
+
+    /// A correction in `rhs` that turns some node by more than half a radian is outside the
+    /// reach of the linearization (and can jump to a rotation increment on another branch of
+    /// the logarithm): scales the whole correction down to that size.
+    fn limit_turn(&mut self) {
+        let mut turn = 0.0f64;
+        for &r in &self.sys.rotations {
+            let d = V3::new(self.rhs[r], self.rhs[r + 1], self.rhs[r + 2]);
+            turn = turn.max(d.norm());
+        }
+        if turn > MAX_TURN {
+            let f = MAX_TURN / turn;
+            self.rhs.iter_mut().for_each(|x| *x *= f);
         }
     }
 
@@ -635,6 +693,9 @@ impl<'s> Integrator<'s> {
 
     /// One step of size `h` from `cur`; on success `cur` holds the new state.
     fn attempt(&mut self, h: f64) -> Result<(), StepFailure> {
+        if self.fet {
+            return self.attempt_fet(h);
+        }
         let sc = self.sc;
         let aug = self.scaling(h);
         let rescale = self.aug.s / aug.s;
@@ -686,19 +747,12 @@ impl<'s> Integrator<'s> {
                 force_weight: 1.0,
             }
         };
-        let ltol = self.set.increment_tolerance * self.sys.length_scale;
-        let atol = self.set.increment_tolerance;
-        let floor = self.sys.mean_mass() * self.sys.length_scale;
-        let mut increment_ok = false;
-        let mut last_increment = f64::NAN;
-        let mut previous_increment = f64::NAN;
-        let mut last = f64::INFINITY;
-        let mut growth = 0;
+        let mut newton = Newton::new(&self.set, self.sys);
         for it in 0..=self.set.max_iterations {
             self.asm.residual(self.sys, &self.trial, aug);
             self.block_matrices();
             let r = &self.asm.residual;
-            let (mut scale, mut cnorm) = (floor, 0.0f64);
+            let (mut scale, mut cnorm) = (newton.floor, 0.0f64);
             for i in 0..n {
                 if self.sys.unknowns[i].is_multiplier() {
                     cnorm = cnorm.max(r.constraint[i].abs());
@@ -729,16 +783,7 @@ impl<'s> Integrator<'s> {
                     worst = (size, i);
                 }
             }
-            // Converged: a small increment, and a small residual or an increment at round-off
-            // level: 1e-3 of the increment tolerance, or a small increment that no longer
-            // shrinks (Newton's quadratic contraction has reached the noise of the residual,
-            // which holds the round-off of accelerations amplified by 1/(beta h^2) and of stiff
-            // elastic forces).
-            let stalled = last_increment <= atol && last_increment > 0.1 * previous_increment;
-            let settled = rnorm <= self.set.residual_tolerance * scale
-                || last_increment <= 1e-3 * atol
-                || stalled;
-            if increment_ok && settled && cnorm <= ltol {
+            if newton.converged(rnorm, scale, cnorm) {
                 self.stats.newton_iterations += it;
                 self.stats.max_constraint_violation =
                     self.stats.max_constraint_violation.max(cnorm);
@@ -756,18 +801,13 @@ impl<'s> Integrator<'s> {
                 self.check_finite()?;
                 return Ok(());
             }
+            let max = self.set.max_iterations;
             let total = rnorm + aug.s * cnorm;
-            growth = if total > last { growth + 1 } else { 0 };
-            last = total;
-            if growth >= 3 || it == self.set.max_iterations {
+            if let Some(detail) = newton.check(it, max, total, (rnorm, scale, cnorm), "") {
                 return Err(StepFailure {
                     kind: FailureKind::NewtonDiverged,
                     entity: Some(self.sys.owners[worst.1]),
-                    detail: format!(
-                        "Newton {} after {it} iteration(s) (residual {rnorm:.3e} against {:.3e}; constraint violation {cnorm:.3e} m and last increment {last_increment:.3e} against {atol:.3e})",
-                        if growth >= 3 { "diverged" } else { "did not converge" },
-                        self.set.residual_tolerance * scale
-                    ),
+                    detail,
                 });
             }
             self.asm.tangent(self.sys, &self.trial, aug, coeffs);
@@ -781,17 +821,8 @@ impl<'s> Integrator<'s> {
                 .factor(&self.asm.values)
                 .map_err(|e| self.singular(e))?;
             self.lu.solve(&mut self.rhs).map_err(|e| self.singular(e))?;
-            // A correction that turns some node by more than half a radian is outside the
-            // reach of the linearization (and can jump to a rotation increment on another
-            // branch of the logarithm): scale the whole correction down to that size.
-            let mut turn = 0.0f64;
-            for &r in &self.sys.rotations {
-                let d = V3::new(self.rhs[r], self.rhs[r + 1], self.rhs[r + 2]);
-                turn = turn.max(d.norm());
-            }
-            if turn > MAX_TURN && !self.conformal {
-                let f = MAX_TURN / turn;
-                self.rhs.iter_mut().for_each(|x| *x *= f);
+            if !self.conformal {
+                self.limit_turn();
             }
             let mut dmax = 0.0f64;
             let tr = &mut self.trial;
@@ -834,9 +865,7 @@ impl<'s> Integrator<'s> {
                 }
             }
             self.newmark(h);
-            increment_ok = dmax <= atol;
-            previous_increment = last_increment;
-            last_increment = dmax;
+            newton.record(dmax);
         }
         Err(StepFailure {
             kind: FailureKind::NewtonDiverged,

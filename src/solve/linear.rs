@@ -105,35 +105,6 @@ impl SparseLu {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn solves_a_small_unsymmetric_system_with_a_zero_diagonal() {
-        // [[4, 1, 1], [1, 3, 0], [1, 0, 0]] x = [6, 4, 1] -> x = (1, 1, 1)
-        let pattern = Pattern {
-            n: 3,
-            col_ptr: vec![0, 3, 5, 6],
-            row_idx: vec![0, 1, 2, 0, 1, 0],
-        };
-        let values = [4.0, 1.0, 1.0, 1.0, 3.0, 1.0];
-        let mut lu = SparseLu::new(&pattern).expect("symbolic");
-        lu.factor(&values).expect("numeric");
-        let mut rhs = [6.0, 4.0, 1.0];
-        lu.solve(&mut rhs).expect("solve");
-        for x in rhs {
-            assert!((x - 1.0).abs() < 1e-14);
-        }
-        // Refactor with new values into the same storage.
-        let values2 = [8.0, 2.0, 2.0, 2.0, 6.0, 2.0];
-        lu.factor(&values2).expect("numeric");
-        let mut rhs = [12.0, 8.0, 2.0];
-        lu.solve(&mut rhs).expect("solve");
-        assert!(rhs.iter().all(|x| (x - 1.0).abs() < 1e-14));
-    }
-}
-
 /// An orthonormal basis of the null space of the `rows x cols` row-major matrix `b`, as the
 /// columns of a column-major `cols x r` array (singular values below `1e-10` of the largest
 /// count as zero).
@@ -187,4 +158,33 @@ pub fn generalized_eigen(
             })
             .collect(),
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn solves_a_small_unsymmetric_system_with_a_zero_diagonal() {
+        // [[4, 1, 1], [1, 3, 0], [1, 0, 0]] x = [6, 4, 1] -> x = (1, 1, 1)
+        let pattern = Pattern {
+            n: 3,
+            col_ptr: vec![0, 3, 5, 6],
+            row_idx: vec![0, 1, 2, 0, 1, 0],
+        };
+        let values = [4.0, 1.0, 1.0, 1.0, 3.0, 1.0];
+        let mut lu = SparseLu::new(&pattern).expect("symbolic");
+        lu.factor(&values).expect("numeric");
+        let mut rhs = [6.0, 4.0, 1.0];
+        lu.solve(&mut rhs).expect("solve");
+        for x in rhs {
+            assert!((x - 1.0).abs() < 1e-14);
+        }
+        // Refactor with new values into the same storage.
+        let values2 = [8.0, 2.0, 2.0, 2.0, 6.0, 2.0];
+        lu.factor(&values2).expect("numeric");
+        let mut rhs = [12.0, 8.0, 2.0];
+        lu.solve(&mut rhs).expect("solve");
+        assert!(rhs.iter().all(|x| (x - 1.0).abs() < 1e-14));
+    }
 }

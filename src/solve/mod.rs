@@ -1,4 +1,5 @@
-//! Solve: System -> trajectory. Newton, HHT-alpha and generalized-alpha, sparse LU reuse.
+//! Solve: System -> trajectory. Newton, HHT-alpha, generalized-alpha and time finite elements,
+//! sparse LU reuse.
 //!
 //! Contract: drives the runtime through its generic interface (residual parts, tangent with
 //! coefficients, constraint rates, rotating nodes); knows no concrete element type and no
@@ -8,6 +9,7 @@
 mod integrator;
 pub mod linear;
 pub mod modes;
+mod newton;
 mod rotations;
 mod se3;
 
@@ -22,7 +24,7 @@ pub enum Method {
     Hht,
     /// Generalized-alpha, Arnold-Bruls form (THEORY §7.5).
     GeneralizedAlpha,
-    /// Time finite elements (not available yet).
+    /// Time finite elements: the bilinear mixed element with midpoint quadrature (THEORY §8.1).
     Fet,
     /// Static equilibrium at each step's time: steps are load steps (loads and prescribed
     /// motions as functions of time), no inertia.
