@@ -10,7 +10,7 @@
 //! once before timing, so error and time sit side by side.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use mbd::model::Overrides;
+use mbd::model::{Integrator, Overrides};
 use std::time::Duration;
 
 fn source() -> String {
@@ -61,10 +61,19 @@ fn fig6(c: &mut Criterion) {
     let text = source();
     let mut group = c.benchmark_group("rotating_beam: half turn (Fig. 6)");
     group.sample_size(10);
-    for steps in [12usize, 18, 36, 180, 360, 720] {
+    let runs = [12usize, 18, 36, 180, 360, 720]
+        .map(|n| (n, Integrator::Hht))
+        .into_iter()
+        .chain([36usize, 180, 720].map(|n| (n, Integrator::Fet)));
+    for (steps, integrator) in runs {
         let o = Overrides {
             steps: Some(steps),
+            integrator: Some(integrator),
             ..Overrides::default()
+        };
+        let label = match integrator {
+            Integrator::Fet => format!("fet/{steps}"),
+            _ => steps.to_string(),
         };
         let Ok(compiled) = mbd::compile("rotating_beam", &text, &[], o) else {
             continue;
@@ -79,9 +88,9 @@ fn fig6(c: &mut Criterion) {
                 .and_then(|s| s.trim().parse().ok())
                 .unwrap_or(f64::NAN);
             let pi = std::f64::consts::PI;
-            eprintln!("{steps} steps: (phi - pi)/pi = {:.3e}", (phi - pi) / pi);
+            eprintln!("{label} steps: (phi - pi)/pi = {:.3e}", (phi - pi) / pi);
         }
-        group.bench_with_input(BenchmarkId::from_parameter(steps), &compiled, |b, c| {
+        group.bench_with_input(BenchmarkId::from_parameter(label), &compiled, |b, c| {
             b.iter(|| {
                 out.clear();
                 mbd::run(c, &mut out).is_ok()

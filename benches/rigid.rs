@@ -1,9 +1,9 @@
 //! Benchmarks of the rigid runtime: the two-bar runs of P3 (1,000 steps) and P4 under each
-//! rotation treatment. Per-step cost = the median divided by 1,000; Newton iterations per step
+//! rotation treatment of HHT, and under time finite elements. Per-step cost = the median divided by 1,000; Newton iterations per step
 //! are printed once before timing.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbd::model::{Overrides, Rotations};
+use mbd::model::{Integrator, Overrides, Rotations};
 
 fn text(model: &str) -> String {
     std::fs::read_to_string(format!("{}/models/{model}", env!("CARGO_MANIFEST_DIR")))
@@ -13,12 +13,14 @@ fn text(model: &str) -> String {
 fn runs(c: &mut Criterion) {
     for model in ["two_bar.mbd", "two_bar_spin.mbd", "pendulum.mbd"] {
         let source = text(model);
-        for (name, rotations) in [
-            ("incremental", Rotations::Incremental),
-            ("conformal", Rotations::Conformal),
+        for (name, rotations, integrator) in [
+            ("incremental", Rotations::Incremental, Integrator::Hht),
+            ("conformal", Rotations::Conformal, Integrator::Hht),
+            ("fet", Rotations::Incremental, Integrator::Fet),
         ] {
             let o = Overrides {
                 rotations: Some(rotations),
+                integrator: Some(integrator),
                 ..Overrides::default()
             };
             let Ok(compiled) = mbd::compile(model, &source, &[], o) else {
