@@ -12,3 +12,4 @@ mod pendulum;
 mod reference;
 mod rigid;
 mod robustness;
+mod study;
