@@ -19,6 +19,7 @@ pub mod runtime;
 pub mod solve;
 pub mod source;
 pub mod stdlib;
+pub mod study;
 pub mod syntax;
 
 use diagnostics::{Code, Diagnostic, Sink};

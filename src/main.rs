@@ -16,6 +16,8 @@ macro_rules! out_line {
     }};
 }
 
+mod study_cmd;
+
 #[derive(Parser)]
 #[command(
     name = "mbd",
@@ -115,6 +117,9 @@ enum Command {
         #[arg(long)]
         title: Option<String>,
     },
+    /// Convergence or stability study: many runs of a model, one channel measured.
+    #[command(long_about = study_cmd::LONG_ABOUT)]
+    Study(study_cmd::StudyArgs),
     /// Explain a diagnostic code, e.g. `mbd explain E0202`.
     Explain { code: String },
 }
@@ -183,6 +188,7 @@ fn main() -> ExitCode {
             emit,
             set,
         } => check(&model, format, emit, &set),
+        Command::Study(args) => study_cmd::study(args),
         Command::Plot {
             csv,
             channels,

@@ -98,3 +98,13 @@ fn no_module_is_past_a_thousand_lines() {
         );
     }
 }
+
+#[test]
+fn the_study_library_does_no_file_io() {
+    for (path, text) in rust_files("src/study") {
+        assert!(
+            !text.contains("std::fs") && !text.contains("File::"),
+            "{path} touches files: the CLI reads and writes them"
+        );
+    }
+}

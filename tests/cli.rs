@@ -4,7 +4,7 @@ use crate::common::{read, repo};
 use std::path::PathBuf;
 use std::process::{Command, Output};
 
-fn mbd(args: &[&str]) -> Output {
+pub fn mbd(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_mbd"))
         .args(args)
         .current_dir(repo(""))
@@ -13,15 +13,15 @@ fn mbd(args: &[&str]) -> Output {
         .expect("run mbd")
 }
 
-fn code(o: &Output) -> i32 {
+pub fn code(o: &Output) -> i32 {
     o.status.code().unwrap_or(-1)
 }
 
-fn stderr(o: &Output) -> String {
+pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
 }
 
-fn temp(name: &str, text: &str) -> PathBuf {
+pub fn temp(name: &str, text: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("mbd-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let p = dir.join(name);

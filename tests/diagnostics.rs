@@ -49,6 +49,9 @@ const CASES: &[(&str, Code)] = &[
     ("knots_out_of_order", Code::E0402),
     ("piecewise_mode", Code::E0403),
     ("driven_twice", Code::E0404),
+    ("exact_unknown_channel", Code::E0405),
+    ("exact_twice", Code::E0406),
+    ("exact_not_a_function", Code::E0407),
     ("unused_declaration", Code::W0202),
     ("floating_body", Code::W0301),
 ];

@@ -322,6 +322,43 @@ fn components_and_loops() {
             "initial spin of = 1 rad/s",
         ],
     );
+    check(
+        Rule::exact_decl,
+        &[
+            "exact phi = Omega * t",
+            "exact rotor.lag[1].angle = 0",
+            "exact zeta[i + 1] = 0.1 * sin(w * t)",
+            "exact x = piecewise { 0 s: 0 m, 1 s: 1 m }",
+        ],
+        &[
+            "exact = 1",
+            "exact phi",
+            "exact phi = ",
+            "exactphi = t",
+            "exact 3 = t",
+        ],
+    );
+}
+
+#[test]
+fn exact_is_a_keyword_only_where_it_starts_an_exact_declaration() {
+    // `param exact = 1` and `exact = c()` stay a param and an instance.
+    let text = "model m\nparam exact = 1\nexact = c()\nexact phi = exact * t\n";
+    let file = mbd::syntax::parse_file(text, mbd::source::SourceId(0));
+    let kinds: Vec<&str> = match &file {
+        Ok(f) => f
+            .items
+            .iter()
+            .map(|i| match i {
+                mbd::syntax::ast::Item::Param { .. } => "param",
+                mbd::syntax::ast::Item::Instance { .. } => "instance",
+                mbd::syntax::ast::Item::Exact { .. } => "exact",
+                _ => "other",
+            })
+            .collect(),
+        Err(d) => panic!("{}", d.message),
+    };
+    assert_eq!(kinds, ["other", "param", "instance", "exact"]);
 }
 
 #[test]

@@ -13,3 +13,4 @@ mod pendulum;
 mod reference;
 mod rigid;
 mod robustness;
+mod study;

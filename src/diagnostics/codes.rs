@@ -114,8 +114,8 @@ instantiates itself, directly or through another component, without an `if` that
         "A component declares the name, but its `export` list does not include it, so it is private \
 to the component. Add it to the component's `export` line, or use an exported name.";
     E0220 = "E0220", "misplaced declaration",
-        "The declaration is not allowed where it is written: `model`, `param`, `gravity` and \
-`solve` belong at the top level of the model file; `component` and `use` may not appear inside \
+        "The declaration is not allowed where it is written: `model`, `param`, `gravity`, \
+`solve` and `exact` belong at the top level of the model file; `component` and `use` may not appear inside \
 a component or a loop; a library file holds components (and the lets, functions and imports \
 they need), not bodies.";
     E0222 = "E0222", "wrong kind of reference",
@@ -180,6 +180,21 @@ default: the end values), `extrapolate` (the end slopes continue) or `periodic`.
         "A joint is both prescribed and loaded (`angle` and `rate`, or `rate` and `torque`), or its \
 prescribed angle is not zero at t = 0. Joint angles are measured from the initial configuration, \
 and a prescribed joint takes whatever torque the motion needs.";
+    E0405 = "E0405", "exact solution of an unknown channel",
+        "An `exact CHANNEL = f(t)` declaration names a channel the model does not output. The \
+name is the CSV column an `output` declares: `output phi = root.angle` makes the channel `phi`, \
+an unnamed `output rotor.lag[1].angle` the channel `rotor.lag[1].angle`, and `output zeta[i] = \
+...` in a loop the channels `zeta1`, `zeta2`, ... The hint lists the model's channels. `mbd \
+study --reference exact` compares the channel with this function of time.";
+    E0406 = "E0406", "exact solution declared twice",
+        "Two `exact` declarations describe the same output channel. A channel has one closed-form \
+solution: keep one of them.";
+    E0407 = "E0407", "exact solution is not a function of time",
+        "The right-hand side of `exact CHANNEL = ...` must be a scalar: a constant or an expression \
+of the time `t`, params and time functions (`ramp`, `step`, `sine`, `piecewise`, a `function`), \
+with the channel's dimension. A vector, a rotation or a reference to a body is not the value of \
+one channel; write the component that channel outputs, e.g. `exact x = L * sin(w * t)` for \
+`output x = bob.position.x`.";
     E0501 = "E0501", "not supported by this runtime",
         "The model is valid, but this version of the runtime cannot simulate one of its elements \
 yet. `mbd check` accepts it; `mbd run` will once the runtime supports the element.";

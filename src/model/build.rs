@@ -171,6 +171,7 @@ pub fn build(
         b.initial(item, *scope);
     }
     let outputs = b.outputs(&out.outputs);
+    let exact = b.exacts(&out.exacts, &outputs);
     let solve = b.solve(out.solve.as_ref(), overrides, top, file.span);
 
     for e in std::mem::take(&mut b.env.errors) {
@@ -204,6 +205,7 @@ pub fn build(
         springs: b.springs,
         loads: b.loads,
         outputs,
+        exact,
         solve: solve?,
         dofs: DofMap::default(),
     };

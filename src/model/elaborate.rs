@@ -36,6 +36,8 @@ pub struct Elaborated {
     pub solve: Option<Item>,
     pub outputs: Vec<(OutputItem, ScopeId)>,
     pub initials: Vec<(Item, ScopeId)>,
+    /// `exact CHANNEL = f(t)` declarations (top level of the model file only).
+    pub exacts: Vec<(Item, ScopeId)>,
     /// Components defined in the model file, with whether they were instantiated.
     pub local_components: Vec<(String, Span)>,
     pub instantiated: HashSet<Span>,
@@ -512,6 +514,12 @@ impl<'a> Elaborator<'a> {
                     return self.misplaced(scope, *span, "initial", at);
                 }
                 self.out.initials.push((item.clone(), scope));
+            }
+            Item::Exact { span, .. } => {
+                if at != Where::Main {
+                    return self.misplaced(scope, *span, "exact", at);
+                }
+                self.out.exacts.push((item.clone(), scope));
             }
             _ => {}
         }

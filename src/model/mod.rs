@@ -12,6 +12,7 @@ pub mod dofs;
 mod elaborate;
 mod env;
 pub mod eval;
+mod exact;
 mod outputs;
 mod settings;
 pub mod topology;
@@ -83,6 +84,8 @@ pub struct Model {
     pub springs: Vec<Spring>,
     pub loads: Vec<Load>,
     pub outputs: Vec<OutputChannel>,
+    /// Closed-form solutions of output channels (`exact phi = Omega * t`).
+    pub exact: Vec<ExactReference>,
     pub solve: SolveSpec,
     pub dofs: DofMap,
 }
@@ -395,6 +398,17 @@ pub struct OutputChannel {
     /// The CSV column name.
     pub column: String,
     pub probe: Probe,
+    pub span: Span,
+}
+
+/// `exact CHANNEL = f(t)`: the closed-form solution of one output channel, the reference of
+/// `mbd study --reference exact`. Not used by a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct ExactReference {
+    /// The CSV column it describes.
+    pub column: String,
+    /// The solution in SI units, a function of time.
+    pub f: TimeFn,
     pub span: Span,
 }
 

@@ -239,6 +239,12 @@ pub enum Item {
         through: Option<Expr>,
         span: Span,
     },
+    /// `exact CHANNEL = expression of t`: the closed-form solution of an output channel.
+    Exact {
+        channel: Path,
+        value: Expr,
+        span: Span,
+    },
     /// `KIND NAME flags (markers) on MARKER = value { block }`
     Entity {
         kind: Ident,
@@ -270,6 +276,7 @@ impl Item {
             | Item::Export { span, .. }
             | Item::Instance { span, .. }
             | Item::Initial { span, .. }
+            | Item::Exact { span, .. }
             | Item::Entity { span, .. } => *span,
         }
     }

@@ -43,6 +43,8 @@ pub fn rule_name(rule: Rule) -> &'static str {
         Rule::kw_of => "`of`",
         Rule::kw_about => "`about`",
         Rule::kw_through => "`through`",
+        Rule::exact_decl => "`exact CHANNEL = expression of t`",
+        Rule::kw_exact => "`exact`",
         Rule::kw_on => "`on`",
         Rule::kw_marker => "`marker`",
         Rule::entity_decl => "a declaration `KIND NAME { ... }`",

@@ -403,6 +403,17 @@ impl Cx {
                     span,
                 }
             }
+            Rule::exact_decl => {
+                // The `exact` keyword is its own pair.
+                let mut it = it.filter(|q| q.as_rule() != Rule::kw_exact);
+                let channel = self.path(take(&mut it, "exact channel")?)?;
+                let value = self.expr(take(&mut it, "exact value")?)?;
+                Item::Exact {
+                    channel,
+                    value,
+                    span,
+                }
+            }
             Rule::entity_decl => {
                 let kind = self.ident(take(&mut it, "declaration kind")?);
                 let name = self.name(take(&mut it, "declaration name")?)?;

@@ -1,0 +1,192 @@
+//! Convergence studies: the error of one channel against a reference, for each integrator
+//! and step, with each run's CPU time; the observed order of each integrator.
+
+use super::compare::{observed_order, relative_error, Order, Reference, Samples};
+use super::{cell, Compile, IntegratorItem};
+use crate::model::Overrides;
+use crate::output::charts::{Chart, Series};
+use crate::runtime::timefn::TimeFn;
+use std::io::{self, Write};
+
+/// What the runs are compared with (`--reference`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReferenceSpec {
+    /// The model's `exact` solution of the channel.
+    Exact(TimeFn),
+    /// One extra run of the first integrator at a quarter of the smallest step.
+    Finest,
+    /// Samples read from a CSV file.
+    Samples(Samples),
+}
+
+/// A convergence study (`mbd study MODEL --channel NAME --integrator LIST --steps LIST`).
+#[derive(Clone, Debug)]
+pub struct ConvergenceSpec {
+    pub channel: String,
+    /// Compare at this time only, else over every output time.
+    pub at: Option<f64>,
+    pub integrators: Vec<IntegratorItem>,
+    /// Step counts; every run ends at `until`.
+    pub steps: Vec<usize>,
+    pub until: f64,
+    pub reference: ReferenceSpec,
+}
+
+/// One run: a row of the study's CSV.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    /// The integrator item as written.
+    pub integrator: String,
+    pub dt: f64,
+    pub steps: usize,
+    /// `None` when the run failed (or could not be compared).
+    pub error: Option<f64>,
+    pub cpu_s: Option<f64>,
+    pub newton_iterations: Option<usize>,
+    /// Why there is no error: the failure's one-line message.
+    pub failure: Option<String>,
+}
+
+/// The finest run, the reference of `--reference finest`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Finest {
+    pub integrator: String,
+    pub dt: f64,
+    pub steps: usize,
+    pub cpu_s: f64,
+    pub failure: Option<String>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Convergence {
+    /// One per (integrator, step), integrators in the order given, then steps as given.
+    pub rows: Vec<Row>,
+    pub finest: Option<Finest>,
+}
+
+/// Runs the study: `base` holds the command line's other overrides.
+pub fn convergence(spec: &ConvergenceSpec, base: &Overrides, compile: &Compile) -> Convergence {
+    let mut jobs: Vec<(Overrides, usize)> = Vec::new();
+    for item in &spec.integrators {
+        for &n in &spec.steps {
+            jobs.push((item.overrides(base), n));
+        }
+    }
+    let finest_steps = spec.steps.iter().max().map(|n| 4 * n).unwrap_or(1);
+    let first = spec.integrators.first();
+    if let (ReferenceSpec::Finest, Some(item)) = (&spec.reference, first) {
+        jobs.push((item.overrides(base), finest_steps));
+    }
+    let mut measured = super::measure_all(compile, &jobs, &spec.channel);
+    let (reference, finest) = match &spec.reference {
+        ReferenceSpec::Exact(f) => (Ok(Reference::Exact(f.clone())), None),
+        ReferenceSpec::Samples(s) => (Ok(Reference::Samples(s.clone())), None),
+        ReferenceSpec::Finest => match measured.pop() {
+            Some(m) => {
+                let finest = Finest {
+                    integrator: first.map(|i| i.text.clone()).unwrap_or_default(),
+                    dt: spec.until / finest_steps as f64,
+                    steps: finest_steps,
+                    cpu_s: m.cpu_s,
+                    failure: m.failure.as_ref().map(|f| f.message.clone()),
+                };
+                let reference = match &m.failure {
+                    None => Ok(Reference::Samples(m.samples)),
+                    Some(f) => Err(format!("the reference run failed: {}", f.message)),
+                };
+                (reference, Some(finest))
+            }
+            None => (Err("no reference run".to_string()), None),
+        },
+    };
+    let mut rows = Vec::new();
+    let mut k = 0;
+    for item in &spec.integrators {
+        for &n in &spec.steps {
+            let m = &measured[k];
+            k += 1;
+            let dt = spec.until / n as f64;
+            let compared = match (&m.failure, &reference) {
+                (Some(f), _) => Err(f.message.clone()),
+                (None, Err(e)) => Err(e.clone()),
+                (None, Ok(r)) => relative_error(&m.samples, r, spec.at, dt),
+            };
+            let ok = m.failure.is_none();
+            rows.push(Row {
+                integrator: item.text.clone(),
+                dt,
+                steps: n,
+                error: compared.as_ref().ok().copied(),
+                cpu_s: ok.then_some(m.cpu_s),
+                newton_iterations: m.newton_iterations,
+                failure: compared.err(),
+            });
+        }
+    }
+    Convergence { rows, finest }
+}
+
+impl Convergence {
+    /// The observed order of each integrator (in the order given), `None` with fewer than
+    /// two runs with an error.
+    pub fn orders(&self) -> Vec<(String, Option<Order>)> {
+        let mut out: Vec<(String, Option<Order>)> = Vec::new();
+        for r in &self.rows {
+            if !out.iter().any(|(name, _)| *name == r.integrator) {
+                let runs: Vec<(f64, f64)> = self
+                    .rows
+                    .iter()
+                    .filter(|x| x.integrator == r.integrator)
+                    .filter_map(|x| x.error.map(|e| (x.dt, e)))
+                    .collect();
+                out.push((r.integrator.clone(), observed_order(&runs)));
+            }
+        }
+        out
+    }
+
+    /// The study's CSV: `integrator,dt,steps,error,cpu_s,newton_iters`, one row per run;
+    /// empty cells where a run failed.
+    pub fn write_csv(&self, out: &mut dyn Write) -> io::Result<()> {
+        writeln!(out, "integrator,dt,steps,error,cpu_s,newton_iters")?;
+        for r in &self.rows {
+            writeln!(
+                out,
+                "{},{},{},{},{},{}",
+                r.integrator,
+                cell(Some(r.dt)),
+                r.steps,
+                cell(r.error),
+                cell(r.cpu_s),
+                r.newton_iterations
+                    .map(|n| n.to_string())
+                    .unwrap_or_default()
+            )?;
+        }
+        Ok(())
+    }
+
+    /// Error against CPU time on log-log axes, one line per integrator (runs by step count).
+    pub fn chart(&self, title: &str, channel: &str) -> Chart {
+        let mut series: Vec<Series> = Vec::new();
+        for (name, _) in self.orders() {
+            let mut runs: Vec<&Row> = self.rows.iter().filter(|r| r.integrator == name).collect();
+            runs.sort_by_key(|r| r.steps);
+            series.push(Series {
+                label: name,
+                points: runs
+                    .iter()
+                    .filter_map(|r| Some((r.cpu_s?, r.error?)))
+                    .collect(),
+            });
+        }
+        Chart {
+            title: title.to_string(),
+            x_label: "CPU time per run [s]".to_string(),
+            y_label: format!("relative error of {channel}"),
+            log_x: true,
+            log_y: true,
+            series,
+        }
+    }
+}

@@ -1,0 +1,426 @@
+//! `mbd study` (part of the binary): parses and checks the flags, reads the model and any
+//! reference file, runs the study through `mbd::study`, writes its CSV and chart and prints
+//! the report. The study itself (runs, errors, orders, onsets) lives in the library.
+
+use super::{compile, read, report, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
+use mbd::model::Overrides;
+use mbd::study::compare::Samples;
+use mbd::study::convergence::{self, ConvergenceSpec, ReferenceSpec};
+use mbd::study::stability::{self, Detector, StabilitySpec};
+use mbd::study::{split_list, IntegratorItem, StepList};
+use std::io::Write;
+use std::process::ExitCode;
+
+/// `mbd study --help`.
+pub const LONG_ABOUT: &str = "\
+Convergence or stability study: runs the model once per integrator (or alpha) and step, in \
+parallel over the cores, and measures one output channel.
+
+Convergence (--integrator LIST): for each run, the error of the channel against the reference,
+
+    error = |y - y_ref| / max_t |y_ref(t)|
+
+at the time --at T, or without --at the largest over the run's output times; the denominator \
+is the reference channel's largest magnitude over the run (1 if it is zero throughout). Values \
+at a time are the row at that time (within 1e-9 dt), else cubic (4-point Lagrange) \
+interpolation. The CSV has the columns integrator,dt,steps,error,cpu_s,newton_iters (cpu_s: \
+thread CPU time of the run alone); a failed run keeps its row with empty cells. The chart \
+plots error against CPU time on log-log axes, one line per integrator. Printed: the table, and \
+each integrator's observed order (least-squares slope of log(error) against log(dt), and the \
+slope between its two finest runs).
+
+Stability (--alpha LIST): HHT at each alpha (and each step of --steps/--dt, else the model's \
+step). For each run, the onset time at which the channel (an acceleration or a joint force) \
+starts to grow without bound, or none. Detector: the alternating part o_k = |y(k+1) - 2 y(k) + \
+y(k-1)| / 4 and its envelope e_k (largest o over the last 40 steps); growth starts where o_k > \
+1e-2 max|y| so far and e_k >= 10 e_(k-40); it was bounded once e falls below a tenth of its \
+peak or sets no new peak for 200 steps; growth still under way when the run ends or fails is \
+unbounded, with its onset the last time before the peak at which e was at most 1/100 of the \
+peak. A failed run's onset is the earlier of that and the failure time. The CSV has the \
+columns integrator,alpha,dt,steps,onset_s,failed_s,cpu_s,newton_iters (empty cell: none); the \
+chart plots |channel| against time, one line per run.
+
+Examples:
+  mbd study models/pendulum.mbd --channel x --integrator hht:-0.1,generalized-alpha --steps 100,200,400,800 -o study.csv --chart study.svg
+  mbd study models/rotating_beam.mbd --channel phi --at 0.032001554992256216 --integrator hht --steps 12,36,108 --reference exact -o beam.csv --chart beam.svg
+  mbd study models/two_bar.mbd --channel ayc2 --alpha 0,-0.1 -o stability.csv --chart stability.svg";
+
+#[derive(clap::Args)]
+pub struct StudyArgs {
+    /// The model file.
+    model: String,
+    /// The output channel to study (a CSV column of the model's `output`).
+    #[arg(long)]
+    channel: String,
+    /// Compare at this time (s) only; default: the largest error over the run.
+    #[arg(long, allow_negative_numbers = true)]
+    at: Option<f64>,
+    /// Convergence: hht, hht:ALPHA, generalized-alpha, generalized-alpha:RHO_INF, fet (comma-separated).
+    #[arg(long, value_name = "LIST")]
+    integrator: Option<String>,
+    /// Stability: HHT alphas in [-1/3, 0] (comma-separated).
+    #[arg(long, value_name = "LIST", allow_hyphen_values = true)]
+    alpha: Option<String>,
+    /// Step counts (comma-separated); dt = until / N.
+    #[arg(long, value_name = "LIST")]
+    steps: Option<String>,
+    /// Time steps in seconds (comma-separated); N = round(until / dt).
+    #[arg(long, value_name = "LIST")]
+    dt: Option<String>,
+    /// exact (the model's `exact` solution), finest (default: a run at a quarter of the
+    /// smallest step) or a CSV file with a `t` (or `time`) column and the channel's.
+    #[arg(long, value_name = "exact|finest|FILE.csv")]
+    reference: Option<String>,
+    /// Override a param: NAME=VALUE, VALUE in SI units or with units (V0=5, V0=5m/s).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    set: Vec<String>,
+    /// Write the study's CSV here.
+    #[arg(short = 'o', long = "output", value_name = "STUDY.csv")]
+    output: String,
+    /// Write the chart here (SVG).
+    #[arg(long, value_name = "STUDY.svg")]
+    chart: Option<String>,
+}
+
+/// `println!` that does not panic when stdout is closed.
+fn say(text: &str) {
+    let _ = writeln!(std::io::stdout().lock(), "{text}");
+}
+
+/// Short numbers for the report: 6 significant digits, no trailing zeros.
+fn short(x: f64) -> String {
+    if !x.is_finite() {
+        return "-".to_string();
+    }
+    let s = format!("{x:.6e}");
+    let v: f64 = s.parse().unwrap_or(x);
+    format!("{v}")
+}
+
+pub fn study(a: StudyArgs) -> ExitCode {
+    let stability = match (&a.integrator, &a.alpha) {
+        (Some(_), Some(_)) => {
+            return usage("give --integrator LIST (a convergence study) or --alpha LIST (a stability study), not both")
+        }
+        (None, None) => {
+            return usage("say what to study: --integrator LIST (convergence, e.g. `--integrator hht,generalized-alpha`) or --alpha LIST (stability, e.g. `--alpha 0,-0.1`)")
+        }
+        (None, Some(_)) => true,
+        (Some(_), None) => false,
+    };
+    if stability && (a.reference.is_some() || a.at.is_some()) {
+        return usage("--reference and --at belong to convergence studies (--integrator), not to stability studies (--alpha)");
+    }
+    let steps = match (&a.steps, &a.dt) {
+        (Some(_), Some(_)) => return usage("give --steps LIST or --dt LIST, not both"),
+        (Some(s), None) => StepList::parse_counts(s).map(Some),
+        (None, Some(d)) => StepList::parse_dt(d).map(Some),
+        (None, None) if stability => Ok(None),
+        (None, None) => {
+            return usage("a convergence study needs the steps: --steps LIST (e.g. 100,200,400) or --dt LIST (seconds)")
+        }
+    };
+    let steps = match steps {
+        Ok(s) => s,
+        Err(e) => return usage(&e),
+    };
+    let text = match read(&a.model) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    let base = Overrides {
+        every: Some(1),
+        ..Overrides::default()
+    };
+    let c = match compile(&a.model, &text, &a.set, base.clone(), Format::Human) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    if let Err(d) = &c.lowered {
+        report(std::slice::from_ref(d), &c.sources, Format::Human);
+        return ExitCode::from(EXIT_MODEL);
+    }
+    let channels: Vec<&str> = c.model.outputs.iter().map(|o| o.column.as_str()).collect();
+    if !channels.contains(&a.channel.as_str()) {
+        let known = if channels.is_empty() {
+            "the model declares no outputs".to_string()
+        } else {
+            format!("its channels are: {}", channels.join(", "))
+        };
+        return usage(&format!(
+            "model `{}` has no output channel `{}`; {known}",
+            a.model, a.channel
+        ));
+    }
+    let until = c.model.solve.until;
+    let counts = match &steps {
+        Some(s) => match s.counts(until) {
+            Ok(n) => n,
+            Err(e) => return usage(&e),
+        },
+        None => vec![c.model.solve.steps],
+    };
+    // Fail on unwritable outputs now, not after the runs.
+    let mut csv_file = match std::fs::File::create(&a.output) {
+        Ok(f) => f,
+        Err(e) => return usage(&format!("cannot create output file `{}`: {e}", a.output)),
+    };
+    let mut chart_file = match &a.chart {
+        Some(p) => match std::fs::File::create(p) {
+            Ok(f) => Some((p.as_str(), f)),
+            Err(e) => return usage(&format!("cannot create chart file `{p}`: {e}")),
+        },
+        None => None,
+    };
+    let (path, sets) = (a.model.as_str(), a.set.as_slice());
+    let compile_job = |o: &Overrides| {
+        mbd::compile_with(path, &text, sets, o.clone(), &FsLoader::new()).map_err(|f| {
+            f.diagnostics
+                .iter()
+                .find(|d| d.is_error())
+                .map(|d| format!("{} {}", d.code.as_str(), d.message))
+                .unwrap_or_else(|| "the model does not compile".to_string())
+        })
+    };
+    let title = format!("{}: {}", c.model.name, a.channel);
+    if stability {
+        let mut alphas = Vec::new();
+        let list = a.alpha.as_deref().unwrap_or_default();
+        match split_list(list, "--alpha") {
+            Ok(items) => {
+                for s in items {
+                    match s.parse::<f64>() {
+                        Ok(v) if (-1.0 / 3.0 - 1e-12..=0.0).contains(&v) => alphas.push(v),
+                        _ => {
+                            return usage(&format!(
+                                "--alpha: `{s}` is not an HHT alpha in [-1/3, 0]"
+                            ))
+                        }
+                    }
+                }
+            }
+            Err(e) => return usage(&e),
+        }
+        let spec = StabilitySpec {
+            channel: a.channel.clone(),
+            alphas,
+            steps: counts,
+            until,
+            detector: Detector::default(),
+        };
+        let rows = stability::stability(&spec, &base, &compile_job);
+        if let Err(e) = stability::write_csv(&rows, &mut csv_file) {
+            return usage(&format!("cannot write `{}`: {e}", a.output));
+        }
+        if let Some((p, f)) = chart_file.as_mut() {
+            draw(p, f, &stability::chart(&rows, &title, &a.channel));
+        }
+        print_stability(&rows, until);
+        return ExitCode::SUCCESS;
+    }
+    let mut integrators = Vec::new();
+    match split_list(a.integrator.as_deref().unwrap_or_default(), "--integrator") {
+        Ok(items) => {
+            for s in items {
+                match IntegratorItem::parse(s) {
+                    Ok(i) => integrators.push(i),
+                    Err(e) => return usage(&e),
+                }
+            }
+        }
+        Err(e) => return usage(&e),
+    }
+    if let Some(t) = a.at {
+        if !(t >= -1e-9 * until && t <= until * (1.0 + 1e-9)) {
+            return usage(&format!(
+                "--at {t} lies outside the run, which goes from 0 to {until} s"
+            ));
+        }
+    }
+    let reference = match reference(&a, &c, until) {
+        Ok(r) => r,
+        Err(code) => return code,
+    };
+    let spec = ConvergenceSpec {
+        channel: a.channel.clone(),
+        at: a.at,
+        integrators,
+        steps: counts,
+        until,
+        reference,
+    };
+    let study = convergence::convergence(&spec, &base, &compile_job);
+    if let Err(e) = study.write_csv(&mut csv_file) {
+        return usage(&format!("cannot write `{}`: {e}", a.output));
+    }
+    if let Some((p, f)) = chart_file.as_mut() {
+        draw(p, f, &study.chart(&title, &a.channel));
+    }
+    print_convergence(&study, &spec);
+    match study.finest.as_ref().and_then(|f| f.failure.as_ref()) {
+        Some(_) => ExitCode::from(EXIT_RUNTIME),
+        None => ExitCode::SUCCESS,
+    }
+}
+
+/// The reference of a convergence study; usage errors exit 2.
+fn reference(a: &StudyArgs, c: &mbd::Compiled, until: f64) -> Result<ReferenceSpec, ExitCode> {
+    match a.reference.as_deref() {
+        None | Some("finest") => Ok(ReferenceSpec::Finest),
+        Some("exact") => match c.model.exact.iter().find(|e| e.column == a.channel) {
+            Some(e) => Ok(ReferenceSpec::Exact(e.f.clone())),
+            None => Err(usage(&format!(
+                "--reference exact: model `{}` declares no exact solution of `{}`\n  hint: add `exact {} = EXPRESSION of t` to the model (see `mbd explain E0405`), or use `--reference finest`",
+                a.model, a.channel, a.channel
+            ))),
+        },
+        Some(file) => {
+            let text = std::fs::read_to_string(file)
+                .map_err(|e| usage(&format!("cannot read reference file `{file}`: {e}")))?;
+            let (header, rows) = mbd::output::read_csv(&text)
+                .map_err(|e| usage(&format!("reference file `{file}` is not a numeric CSV: {e}")))?;
+            let s = Samples::from_table(&header, &rows, &a.channel)
+                .map_err(|e| usage(&format!("reference file `{file}`: {e}")))?;
+            s.check_increasing()
+                .map_err(|e| usage(&format!("reference file `{file}`: {e}")))?;
+            let covers = match s.span() {
+                Some((first, last)) => first <= 1e-9 * until && last >= until * (1.0 - 1e-9),
+                None => false,
+            };
+            if !covers {
+                return Err(usage(&format!(
+                    "reference file `{file}` must cover the run, from 0 to {until} s{}",
+                    s.span()
+                        .map(|(f, l)| format!("; it goes from {f} to {l} s"))
+                        .unwrap_or_else(|| "; it has no rows".to_string())
+                )));
+            }
+            Ok(ReferenceSpec::Samples(s))
+        }
+    }
+}
+
+/// Renders a chart into its (already created) file; a chart with nothing to draw is a note.
+fn draw(path: &str, file: &mut std::fs::File, chart: &mbd::output::charts::Chart) {
+    match mbd::output::charts::render(chart) {
+        Ok(svg) => {
+            if let Err(e) = file.write_all(svg.as_bytes()) {
+                eprintln!("error: cannot write chart file `{path}`: {e}");
+            }
+        }
+        Err(e) => eprintln!("note: no chart drawn in `{path}`: {e}"),
+    }
+}
+
+fn print_convergence(study: &convergence::Convergence, spec: &ConvergenceSpec) {
+    match (&spec.reference, &study.finest) {
+        (ReferenceSpec::Exact(_), _) => say(&format!(
+            "reference: the exact solution of {}",
+            spec.channel
+        )),
+        (ReferenceSpec::Samples(_), _) => say("reference: the reference file"),
+        (ReferenceSpec::Finest, Some(f)) => {
+            say(&format!(
+                "reference: finest run, {} with dt = {} s ({} steps, {} s CPU)",
+                f.integrator,
+                short(f.dt),
+                f.steps,
+                short(f.cpu_s)
+            ));
+            if let Some(m) = &f.failure {
+                say(&format!("  the reference run failed: {m}"));
+            }
+        }
+        (ReferenceSpec::Finest, None) => {}
+    }
+    let width = study
+        .rows
+        .iter()
+        .map(|r| r.integrator.len())
+        .max()
+        .unwrap_or(0)
+        .max("integrator".len());
+    say(&format!(
+        "{:<width$}  {:>12}  {:>8}  {:>12}  {:>10}  {:>8}",
+        "integrator", "dt [s]", "steps", "error", "cpu [s]", "newton"
+    ));
+    for r in &study.rows {
+        let num = |x: Option<f64>, p: usize| match x {
+            Some(v) => format!("{v:.p$e}"),
+            None => "-".to_string(),
+        };
+        say(&format!(
+            "{:<width$}  {:>12}  {:>8}  {:>12}  {:>10}  {:>8}",
+            r.integrator,
+            num(Some(r.dt), 4),
+            r.steps,
+            num(r.error, 4),
+            num(r.cpu_s, 3),
+            r.newton_iterations
+                .map(|n| n.to_string())
+                .unwrap_or_else(|| "-".to_string())
+        ));
+    }
+    for r in study.rows.iter().filter(|r| r.failure.is_some()) {
+        say(&format!(
+            "{}, {} steps: {}",
+            r.integrator,
+            r.steps,
+            r.failure.as_deref().unwrap_or_default()
+        ));
+    }
+    for (name, order) in study.orders() {
+        match order {
+            Some(o) => say(&format!(
+                "{name}  observed order {:.2} (finest pair {:.2})",
+                o.fit, o.finest_pair
+            )),
+            None => say(&format!(
+                "{name}  observed order: fewer than two runs with an error"
+            )),
+        }
+    }
+}
+
+fn print_stability(rows: &[stability::StabilityRow], until: f64) {
+    let several_steps = rows.iter().any(|r| r.steps != rows[0].steps);
+    say(&format!(
+        "{:>8}  {:>12}  {:>8}  {:>10}  {:>10}  {:>10}  {:>8}",
+        "alpha", "dt [s]", "steps", "onset [s]", "failed [s]", "cpu [s]", "newton"
+    ));
+    let opt = |x: Option<f64>| x.map(short).unwrap_or_else(|| "-".to_string());
+    for r in rows {
+        say(&format!(
+            "{:>8}  {:>12}  {:>8}  {:>10}  {:>10}  {:>10}  {:>8}",
+            r.alpha,
+            short(r.dt),
+            r.steps,
+            opt(r.onset),
+            opt(r.failed),
+            r.cpu_s
+                .map(|c| format!("{c:.3e}"))
+                .unwrap_or_else(|| "-".to_string()),
+            r.newton_iterations
+                .map(|n| n.to_string())
+                .unwrap_or_else(|| "-".to_string())
+        ));
+    }
+    for r in rows {
+        let which = if several_steps {
+            format!("alpha = {}, dt = {} s", r.alpha, short(r.dt))
+        } else {
+            format!("alpha = {}", r.alpha)
+        };
+        let failed = r
+            .failed
+            .map(|f| format!(" (the run failed at {f:.2} s)"))
+            .unwrap_or_default();
+        match r.onset {
+            Some(t) => say(&format!("{which}: onset at {t:.2} s{failed}")),
+            None => match &r.failure {
+                Some(m) => say(&format!("{which}: the run failed: {m}")),
+                None => say(&format!("{which}: no growth through {} s", short(until))),
+            },
+        }
+    }
+}
