@@ -67,6 +67,9 @@ pub struct StudyArgs {
     /// Time steps in seconds (comma-separated); N = round(until / dt).
     #[arg(long, value_name = "LIST")]
     dt: Option<String>,
+    /// End time in seconds (default: the model's).
+    #[arg(long)]
+    until: Option<f64>,
     /// exact (the model's `exact` solution), finest (default: a run at a quarter of the
     /// smallest step) or a CSV file with a `t` (or `time`) column and the channel's.
     #[arg(long, value_name = "exact|finest|FILE.csv")]
@@ -128,8 +131,14 @@ pub fn study(a: StudyArgs) -> ExitCode {
         Ok(t) => t,
         Err(code) => return code,
     };
+    if let Some(t) = a.until {
+        if !(t.is_finite() && t > 0.0) {
+            return usage(&format!("--until must be a positive time in seconds, got {t}"));
+        }
+    }
     let base = Overrides {
         every: Some(1),
+        until: a.until,
         ..Overrides::default()
     };
     let c = match compile(&a.model, &text, &a.set, base.clone(), Format::Human) {
@@ -379,6 +388,18 @@ fn print_convergence(study: &convergence::Convergence, spec: &ConvergenceSpec) {
                 "{name}  observed order: fewer than two runs with an error"
             )),
         }
+    }
+    for (name, _) in study.orders() {
+        let reach = |target: f64| match study.cpu_to_reach(&name, target) {
+            Some((c, false)) => format!("{} s", short(c)),
+            Some((c, true)) => format!("{} s (extrapolated)", short(c)),
+            None => "-".to_string(),
+        };
+        say(&format!(
+            "{name}  CPU to reach 1e-3: {}; 1e-6: {}",
+            reach(1e-3),
+            reach(1e-6)
+        ));
     }
 }
 

@@ -145,6 +145,42 @@ impl Convergence {
         out
     }
 
+    /// The CPU time integrator `name` needs to reach relative error `target`: log-log
+    /// interpolation between the two runs that bracket it, else extrapolation along the line
+    /// through its two most accurate runs (then `extrapolated` is true). `None` with fewer than
+    /// two runs, or when the line does not fall.
+    pub fn cpu_to_reach(&self, name: &str, target: f64) -> Option<(f64, bool)> {
+        let mut runs: Vec<(f64, f64)> = self
+            .rows
+            .iter()
+            .filter(|r| r.integrator == name)
+            .filter_map(|r| Some((r.cpu_s?, r.error?)))
+            .filter(|(c, e)| *c > 0.0 && *e > 0.0)
+            .collect();
+        runs.sort_by(|a, b| b.1.total_cmp(&a.1));
+        if runs.len() < 2 || !(target > 0.0) {
+            return None;
+        }
+        let through = |(c0, e0): (f64, f64), (c1, e1): (f64, f64)| -> Option<f64> {
+            let slope = (e1.ln() - e0.ln()) / (c1.ln() - c0.ln());
+            (slope < 0.0 && slope.is_finite())
+                .then(|| (c0.ln() + (target.ln() - e0.ln()) / slope).exp())
+        };
+        if let Some(w) = runs
+            .windows(2)
+            .find(|w| w[0].1 >= target && target >= w[1].1)
+        {
+            return through(w[0], w[1]).map(|c| (c, false));
+        }
+        let n = runs.len();
+        let (a, b) = if target > runs[0].1 {
+            (runs[0], runs[1])
+        } else {
+            (runs[n - 2], runs[n - 1])
+        };
+        through(a, b).map(|c| (c, true))
+    }
+
     /// The study's CSV: `integrator,dt,steps,error,cpu_s,newton_iters`, one row per run;
     /// empty cells where a run failed.
     pub fn write_csv(&self, out: &mut dyn Write) -> io::Result<()> {
@@ -188,5 +224,41 @@ impl Convergence {
             log_y: true,
             series,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn row(cpu: f64, error: f64) -> Row {
+        Row {
+            integrator: "hht".to_string(),
+            dt: 0.0,
+            steps: 0,
+            error: Some(error),
+            cpu_s: Some(cpu),
+            newton_iterations: None,
+            failure: None,
+        }
+    }
+
+    #[test]
+    fn cpu_to_reach_interpolates_and_extrapolates_in_log_log() {
+        // error = 1e-6 / cpu^2: 1e-2 at 0.01 s, 1e-4 at 0.1 s.
+        let study = Convergence {
+            rows: vec![row(0.01, 1e-2), row(0.1, 1e-4)],
+            finest: None,
+        };
+        let (c, extrapolated) = study.cpu_to_reach("hht", 1e-3).expect("bracketed");
+        assert!(!extrapolated && (c - 10f64.powf(-1.5)).abs() < 1e-12, "{c}");
+        let (c, extrapolated) = study.cpu_to_reach("hht", 1e-6).expect("extrapolated");
+        assert!(extrapolated && (c - 1.0).abs() < 1e-12, "{c}");
+        assert_eq!(study.cpu_to_reach("other", 1e-3), None);
+        let flat = Convergence {
+            rows: vec![row(0.01, 1e-2), row(0.1, 1e-2)],
+            finest: None,
+        };
+        assert_eq!(flat.cpu_to_reach("hht", 1e-6), None);
     }
 }
