@@ -133,7 +133,9 @@ pub fn study(a: StudyArgs) -> ExitCode {
     };
     if let Some(t) = a.until {
         if !(t.is_finite() && t > 0.0) {
-            return usage(&format!("--until must be a positive time in seconds, got {t}"));
+            return usage(&format!(
+                "--until must be a positive time in seconds, got {t}"
+            ));
         }
     }
     let base = Overrides {

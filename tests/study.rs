@@ -341,7 +341,11 @@ fn failed_runs_keep_their_rows_and_do_not_stop_the_study() {
     assert!(number(&rows[0][3]) > 0.0, "{:?}", rows[0]);
     assert_eq!(rows[1][0], "hht:0");
     assert_eq!(
-        (rows[1][3].as_str(), rows[1][4].as_str(), rows[1][5].as_str()),
+        (
+            rows[1][3].as_str(),
+            rows[1][4].as_str(),
+            rows[1][5].as_str()
+        ),
         ("", "", "")
     );
     assert!(stdout(&o).contains("E0601"), "{}", stdout(&o));

@@ -158,7 +158,7 @@ impl Convergence {
             .filter(|(c, e)| *c > 0.0 && *e > 0.0)
             .collect();
         runs.sort_by(|a, b| b.1.total_cmp(&a.1));
-        if runs.len() < 2 || !(target > 0.0) {
+        if runs.len() < 2 || target.is_nan() || target <= 0.0 {
             return None;
         }
         let through = |(c0, e0): (f64, f64), (c1, e1): (f64, f64)| -> Option<f64> {
