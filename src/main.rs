@@ -17,6 +17,7 @@ macro_rules! out_line {
 }
 
 mod study_cmd;
+mod stability_cmd;
 
 #[derive(Parser)]
 #[command(
@@ -120,6 +121,9 @@ enum Command {
     /// Convergence or stability study: many runs of a model, one channel measured.
     #[command(long_about = study_cmd::LONG_ABOUT)]
     Study(study_cmd::StudyArgs),
+    /// Stability sweep: characteristic exponents (Floquet, Prony) against a param.
+    #[command(long_about = stability_cmd::LONG_ABOUT)]
+    Stability(stability_cmd::StabilityArgs),
     /// Explain a diagnostic code, e.g. `mbd explain E0202`.
     Explain { code: String },
 }
@@ -189,6 +193,7 @@ fn main() -> ExitCode {
             set,
         } => check(&model, format, emit, &set),
         Command::Study(args) => study_cmd::study(args),
+        Command::Stability(args) => stability_cmd::stability(args),
         Command::Plot {
             csv,
             channels,

@@ -12,6 +12,8 @@ use plotters::prelude::*;
 pub struct Series {
     pub label: String,
     pub points: Vec<(f64, f64)>,
+    /// Markers without a line (scattered values, e.g. every mode's exponent).
+    pub markers_only: bool,
 }
 
 /// What to draw.
@@ -23,6 +25,8 @@ pub struct Chart {
     pub log_x: bool,
     pub log_y: bool,
     pub series: Vec<Series>,
+    /// Ranges of x shaded in light red (unstable ranges of a stability chart).
+    pub shaded: Vec<(f64, f64)>,
 }
 
 /// Distinct line colours (Tableau 10).
@@ -101,6 +105,24 @@ pub fn render(chart: &Chart) -> Result<String, String> {
                     .y_desc(chart.y_label.as_str())
                     .draw()
                     .map_err(e)?;
+                let shade = RGBColor(214, 39, 40).mix(0.12);
+                for (k, &(a, b)) in chart.shaded.iter().enumerate() {
+                    let (a, b) = (a.max(x0), b.min(x1));
+                    if !(b > a) {
+                        continue;
+                    }
+                    let area = c
+                        .draw_series(std::iter::once(Rectangle::new(
+                            [(a, y0), (b, y1)],
+                            shade.filled(),
+                        )))
+                        .map_err(e)?;
+                    if k == 0 {
+                        area.label("unstable").legend(move |(x, y)| {
+                            Rectangle::new([(x, y - 5), (x + 20, y + 5)], shade.filled())
+                        });
+                    }
+                }
                 for (k, s) in chart.series.iter().enumerate() {
                     let colour = PALETTE[k % PALETTE.len()];
                     let points: Vec<(f64, f64)> = s
@@ -109,6 +131,13 @@ pub fn render(chart: &Chart) -> Result<String, String> {
                         .copied()
                         .filter(|p| kept(p, lx, ly))
                         .collect();
+                    if s.markers_only {
+                        c.draw_series(points.iter().map(|&p| Circle::new(p, 2, colour.filled())))
+                            .map_err(e)?
+                            .label(s.label.as_str())
+                            .legend(move |(x, y)| Circle::new((x + 10, y), 3, colour.filled()));
+                        continue;
+                    }
                     let style = colour.stroke_width(2);
                     c.draw_series(LineSeries::new(points.iter().copied(), style))
                         .map_err(e)?
@@ -167,6 +196,7 @@ pub fn time_history(
         series.push(Series {
             label: name.clone(),
             points: rows.iter().map(|r| (r[t], r[k])).collect(),
+            markers_only: false,
         });
     }
     Ok(Chart {
@@ -180,6 +210,7 @@ pub fn time_history(
         log_x: false,
         log_y: false,
         series,
+        shaded: Vec::new(),
     })
 }
 
@@ -197,7 +228,9 @@ mod tests {
             series: vec![Series {
                 label: "s".into(),
                 points,
+                markers_only: false,
             }],
+            shaded: Vec::new(),
         }
     }
 

@@ -350,6 +350,20 @@ impl<'s> Integrator<'s> {
         }
     }
 
+    /// Starts over from `initial` (a state in the physical layout, like `System::initial`)
+    /// at its time, keeping the symbolic factorization, then initializes as [`Self::initialize`]
+    /// does. Floquet analysis starts its perturbed runs this way.
+    pub fn restart(&mut self, initial: &State) -> Result<Vec<Notice>, RuntimeFailure> {
+        self.cur.clone_from(initial);
+        self.trial.clone_from(initial);
+        self.mid.clone_from(initial);
+        self.start_stiffness = 0.0;
+        self.stats = RunStats::default();
+        self.step_index = 0;
+        self.aug = self.scaling(self.set.dt);
+        self.initialize()
+    }
+
     /// Makes the initial state consistent: positions and velocities onto the constraints,
     /// then accelerations and multipliers (consistent start) or zeros (the paper's start).
     pub fn initialize(&mut self) -> Result<Vec<Notice>, RuntimeFailure> {

@@ -134,6 +134,58 @@ pub fn null_space(b: &[f64], rows: usize, cols: usize) -> Option<(Vec<f64>, usiz
     Some((out, r))
 }
 
+/// The thin singular value decomposition of the `rows x cols` row-major matrix `a`: the
+/// singular values in decreasing order and the matching right singular vectors, as the columns
+/// of a column-major `cols x k` array (`k = min(rows, cols)`).
+pub fn svd_right(a: &[f64], rows: usize, cols: usize) -> Option<(Vec<f64>, Vec<f64>)> {
+    let m = faer::Mat::<f64>::from_fn(rows, cols, |i, j| a[i * cols + j]);
+    let svd = m.thin_svd().ok()?;
+    let s = svd.S().column_vector();
+    let v = svd.V();
+    let k = s.nrows();
+    let mut order: Vec<usize> = (0..k).collect();
+    order.sort_by(|&x, &y| s[y].abs().total_cmp(&s[x].abs()));
+    let values = order.iter().map(|&i| s[i].abs()).collect();
+    let mut vecs = vec![0.0; cols * k];
+    for (j, &o) in order.iter().enumerate() {
+        for i in 0..cols {
+            vecs[j * cols + i] = v[(i, o)];
+        }
+    }
+    Some((values, vecs))
+}
+
+/// The minimum-norm least-squares solution of `a x = b` (`a`: `rows x cols`, `b`:
+/// `rows x nrhs`, both row-major; result `cols x nrhs` row-major), singular values below
+/// `cutoff` of the largest dropped.
+pub fn least_squares(
+    a: &[f64],
+    rows: usize,
+    cols: usize,
+    b: &[f64],
+    nrhs: usize,
+    cutoff: f64,
+) -> Option<Vec<f64>> {
+    let m = faer::Mat::<f64>::from_fn(rows, cols, |i, j| a[i * cols + j]);
+    let svd = m.thin_svd().ok()?;
+    let (u, s, v) = (svd.U(), svd.S().column_vector(), svd.V());
+    let k = s.nrows();
+    let smax = (0..k).map(|i| s[i].abs()).fold(0.0, f64::max);
+    let mut x = vec![0.0; cols * nrhs];
+    for i in 0..k {
+        if !(s[i].abs() > cutoff * smax) {
+            continue;
+        }
+        for r in 0..nrhs {
+            let ub: f64 = (0..rows).map(|p| u[(p, i)] * b[p * nrhs + r]).sum::<f64>() / s[i];
+            for j in 0..cols {
+                x[j * nrhs + r] += v[(j, i)] * ub;
+            }
+        }
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
 /// Generalized eigenvalues `alpha / beta` and right eigenvectors of `A z = s B z` for real
 /// column-major `n x n` matrices (QZ): `(alpha, beta, vector)` with complex numbers as
 /// `(re, im)`.

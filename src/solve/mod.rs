@@ -6,6 +6,7 @@
 //! spans. Failures are typed [`RuntimeFailure`]s naming the time, the step and the entity with
 //! the largest residual.
 
+pub mod floquet;
 mod integrator;
 pub mod linear;
 pub mod modes;

@@ -214,6 +214,7 @@ impl Convergence {
                     .iter()
                     .filter_map(|r| Some((r.cpu_s?, r.error?)))
                     .collect(),
+                markers_only: false,
             });
         }
         Chart {
@@ -223,6 +224,7 @@ impl Convergence {
             log_x: true,
             log_y: true,
             series,
+            shaded: Vec::new(),
         }
     }
 }

@@ -11,7 +11,9 @@
 
 pub mod compare;
 pub mod convergence;
+pub mod prony;
 pub mod stability;
+pub mod sweep;
 
 use crate::model::{Integrator, Overrides};
 use crate::Compiled;

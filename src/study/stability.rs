@@ -232,8 +232,10 @@ pub fn chart(rows: &[StabilityRow], title: &str, channel: &str) -> Chart {
                     .zip(&r.samples.y)
                     .map(|(&t, &y)| (t, y.abs()))
                     .collect(),
+                markers_only: false,
             })
             .collect(),
+        shaded: Vec::new(),
     }
 }
 

@@ -1,0 +1,371 @@
+//! `mbd stability` (part of the binary): parses the flags, reads the model and any reference
+//! file, runs the sweep through `mbd::study::sweep` with a progress bar, writes the CSV and the
+//! chart and prints the report. The analysis itself lives in the library.
+
+use super::{compile, read, report, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
+use mbd::model::Overrides;
+use mbd::output::charts::Series;
+use mbd::study::sweep::{self, Method, SweepSpec, Tick};
+use std::io::{IsTerminal, Write};
+use std::process::ExitCode;
+
+/// `mbd stability --help`.
+pub const LONG_ABOUT: &str = "\
+Stability sweep: for each value of a param, the characteristic exponents s of the model's \
+motion, and the edges of the unstable ranges.
+
+Floquet (--method floquet, the default): the monodromy matrix of the motion over one period T \
+(2 pi / Omega of the joint driven at a constant speed, or --period), built from perturbed \
+integrations in the constraint-free subspace with the model's integrator and step (THEORY \
+§9.2): 4 n_f + 1 runs of one period, n_f the free coordinates. Exponents s = (ln|Lambda| + \
+i arg Lambda) / T; the frequency is known only modulo 2 pi / T and is reported on the \
+principal branch, |Im s| <= pi / T.
+
+Prony (--method prony): the poles of a transient, the model's own run (its excitation \
+included), fitted by the matrix pencil method over --window (default: from a tenth of the run \
+to its end), sampled about --samples times, all output channels (or --signals) sharing the \
+poles (THEORY §9.3). Frequencies are those of the signals (rotating-frame signals show \
+the rotor's harmonics).
+
+--method both runs both; the first listed method locates the edges. A point is unstable when \
+its largest real part exceeds --threshold. Between neighbouring values of opposite stability \
+the edge is bisected --refine times.
+
+The CSV has the columns PARAM,max_real,min_damping_ratio,method, then freq1,real1,freq2,\
+real2,... (rad/s and 1/s, modes by decreasing real part, conjugates once with freq >= 0; \
+empty cells where a point failed). The chart plots the real parts against the param, the \
+largest as a line, with the unstable ranges shaded; --reference FILE.csv adds the columns of \
+a CSV (its first column the param) as lines.
+
+Examples:
+  mbd stability models/windmill.mbd --sweep Omega_bar=0.8:2.6:0.05 -o stab.csv --chart stab.svg
+  mbd stability models/windmill.mbd --sweep Omega_bar=1.0:2.5:0.5 --method both --set blades=3 -o stab.csv";
+
+#[derive(clap::Args)]
+pub struct StabilityArgs {
+    /// The model file.
+    model: String,
+    /// The param and its values: NAME=START:STOP:STEP (STOP included).
+    #[arg(long, value_name = "NAME=START:STOP:STEP", allow_hyphen_values = true)]
+    sweep: String,
+    /// floquet, prony or both.
+    #[arg(long, value_enum, default_value = "floquet")]
+    method: MethodArg,
+    /// Floquet: the period in seconds (default: 2 pi / Omega of the driven rotor).
+    #[arg(long)]
+    period: Option<f64>,
+    /// Prony: the channels to fit (comma-separated; default: every output channel).
+    #[arg(long, value_name = "LIST")]
+    signals: Option<String>,
+    /// Prony: the part of the run to fit, FROM:TO in seconds.
+    #[arg(long, value_name = "FROM:TO")]
+    window: Option<String>,
+    /// Prony: about this many samples over the window.
+    #[arg(long, default_value_t = 300)]
+    samples: usize,
+    /// Unstable when the largest real part exceeds this (1/s).
+    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    threshold: f64,
+    /// Bisections of each edge of an unstable range.
+    #[arg(long, default_value_t = 6)]
+    refine: usize,
+    /// Override a param: NAME=VALUE, VALUE in SI units or with units.
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    set: Vec<String>,
+    /// A CSV whose first column is the param and whose other columns are drawn as lines.
+    #[arg(long, value_name = "FILE.csv")]
+    reference: Option<String>,
+    /// Write the sweep's CSV here.
+    #[arg(short = 'o', long = "output", value_name = "STAB.csv")]
+    output: String,
+    /// Write the chart here (SVG).
+    #[arg(long, value_name = "STAB.svg")]
+    chart: Option<String>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum MethodArg {
+    Floquet,
+    Prony,
+    Both,
+}
+
+fn say(text: &str) {
+    let _ = writeln!(std::io::stdout().lock(), "{text}");
+}
+
+fn short(x: f64) -> String {
+    if !x.is_finite() {
+        return "-".to_string();
+    }
+    let s = format!("{x:.5e}");
+    let v: f64 = s.parse().unwrap_or(x);
+    format!("{v}")
+}
+
+pub fn stability(a: StabilityArgs) -> ExitCode {
+    let Some((param, range)) = a.sweep.split_once('=') else {
+        return usage(&format!(
+            "--sweep takes NAME=START:STOP:STEP, e.g. Omega_bar=0.8:2.6:0.05; got `{}`",
+            a.sweep
+        ));
+    };
+    let param = param.trim().to_string();
+    let values = match sweep::parse_range(range) {
+        Ok(v) => v,
+        Err(e) => return usage(&format!("--sweep: {e}")),
+    };
+    if a.set
+        .iter()
+        .any(|s| s.split_once('=').map(|(n, _)| n.trim()) == Some(param.as_str()))
+    {
+        return usage(&format!(
+            "--set {param}=... conflicts with --sweep {param}=...; drop one"
+        ));
+    }
+    if let Some(t) = a.period {
+        if !(t.is_finite() && t > 0.0) {
+            return usage(&format!("--period must be a positive time in seconds, got {t}"));
+        }
+    }
+    if !a.threshold.is_finite() {
+        return usage("--threshold must be a number (1/s)");
+    }
+    let window = match &a.window {
+        None => None,
+        Some(w) => {
+            let parsed = w.split_once(':').and_then(|(f, t)| {
+                Some((f.trim().parse::<f64>().ok()?, t.trim().parse::<f64>().ok()?))
+            });
+            match parsed {
+                Some((f, t)) if f.is_finite() && t.is_finite() && f >= 0.0 && t > f => {
+                    Some((f, t))
+                }
+                _ => {
+                    return usage(&format!(
+                        "--window takes FROM:TO in seconds with 0 <= FROM < TO, got `{w}`"
+                    ))
+                }
+            }
+        }
+    };
+    let methods = match a.method {
+        MethodArg::Floquet => vec![Method::Floquet],
+        MethodArg::Prony => vec![Method::Prony],
+        MethodArg::Both => vec![Method::Floquet, Method::Prony],
+    };
+    let prony = methods.contains(&Method::Prony);
+    if !prony && (a.window.is_some() || a.signals.is_some()) {
+        return usage("--window and --signals belong to --method prony or both");
+    }
+    if methods.contains(&Method::Prony) && a.samples < 12 {
+        return usage("--samples must be at least 12");
+    }
+    let text = match read(&a.model) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    // The model compiles at the first value (reports its errors and warnings once).
+    let mut first_sets = a.set.clone();
+    first_sets.push(format!("{param}={}", values[0]));
+    let c = match compile(&a.model, &text, &first_sets, Overrides::default(), Format::Human) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    if let Err(d) = &c.lowered {
+        report(std::slice::from_ref(d), &c.sources, Format::Human);
+        return ExitCode::from(EXIT_MODEL);
+    }
+    if !c.model.params.iter().any(|(n, _)| *n == param) {
+        let known: Vec<&str> = c.model.params.iter().map(|(n, _)| n.as_str()).collect();
+        return usage(&format!(
+            "model `{}` has no param `{param}`; its params are: {}",
+            a.model,
+            known.join(", ")
+        ));
+    }
+    let signals: Vec<String> = a
+        .signals
+        .as_deref()
+        .map(|s| s.split(',').map(|x| x.trim().to_string()).collect())
+        .unwrap_or_default();
+    let channels: Vec<&str> = c.model.outputs.iter().map(|o| o.column.as_str()).collect();
+    if let Some(bad) = signals.iter().find(|s| !channels.contains(&s.as_str())) {
+        return usage(&format!(
+            "model `{}` has no output channel `{bad}`; its channels are: {}",
+            a.model,
+            channels.join(", ")
+        ));
+    }
+    if prony && channels.is_empty() && signals.is_empty() {
+        return usage("Prony needs output channels to fit: the model declares no `output`");
+    }
+    if methods.contains(&Method::Floquet) && a.period.is_none() {
+        if let Err(e) = sweep::rotor_period(&c) {
+            return usage(&e);
+        }
+    }
+    let reference = match &a.reference {
+        None => Vec::new(),
+        Some(p) => match reference_series(p) {
+            Ok(s) => s,
+            Err(e) => return usage(&e),
+        },
+    };
+    let mut csv_file = match std::fs::File::create(&a.output) {
+        Ok(f) => f,
+        Err(e) => return usage(&format!("cannot create output file `{}`: {e}", a.output)),
+    };
+    let mut chart_file = match &a.chart {
+        Some(p) => match std::fs::File::create(p) {
+            Ok(f) => Some((p.as_str(), f)),
+            Err(e) => return usage(&format!("cannot create chart file `{p}`: {e}")),
+        },
+        None => None,
+    };
+    let spec = SweepSpec {
+        param: param.clone(),
+        values,
+        methods,
+        period: a.period,
+        signals,
+        window,
+        samples: a.samples,
+        threshold: a.threshold,
+        refine: a.refine,
+    };
+    let (path, sets) = (a.model.as_str(), a.set.as_slice());
+    let compile_job = |extra: &[String]| {
+        let mut all = sets.to_vec();
+        all.extend_from_slice(extra);
+        mbd::compile_with(path, &text, &all, Overrides::default(), &FsLoader::new()).map_err(
+            |f| {
+                f.diagnostics
+                    .iter()
+                    .find(|d| d.is_error())
+                    .map(|d| format!("{} {}", d.code.as_str(), d.message))
+                    .unwrap_or_else(|| "the model does not compile".to_string())
+            },
+        )
+    };
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let b = indicatif::ProgressBar::new(0);
+        if let Ok(style) = indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:40}] {pos}/{len} evaluations, {eta} left",
+        ) {
+            b.set_style(style.progress_chars("=> "));
+        }
+        b
+    });
+    let tick = |t: Tick| {
+        if let Some(b) = &bar {
+            match t {
+                Tick::Planned(n) => b.inc_length(n as u64),
+                Tick::Done => b.inc(1),
+            }
+        }
+    };
+    let result = sweep::sweep(&spec, &compile_job, &tick);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    if let Err(e) = result.write_csv(&mut csv_file) {
+        return usage(&format!("cannot write `{}`: {e}", a.output));
+    }
+    if let Some((p, f)) = chart_file.as_mut() {
+        let title = format!("{}: stability against {param}", c.model.name);
+        match mbd::output::charts::render(&result.chart(&title, reference)) {
+            Ok(svg) => {
+                if let Err(e) = f.write_all(svg.as_bytes()) {
+                    eprintln!("error: cannot write `{p}`: {e}");
+                }
+            }
+            Err(e) => eprintln!("warning: no chart written to `{p}`: {e}"),
+        }
+    }
+    print_report(&result);
+    if result.points.iter().any(|p| p.failure.is_some()) {
+        ExitCode::from(EXIT_RUNTIME)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+/// The columns of a reference CSV as lines against its first column.
+fn reference_series(path: &str) -> Result<Vec<Series>, String> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| format!("cannot read `{path}`: {e}"))?;
+    let (header, rows) =
+        mbd::output::read_csv(&text).map_err(|e| format!("`{path}`: {e}"))?;
+    if header.len() < 2 {
+        return Err(format!(
+            "`{path}` needs the param in its first column and at least one more column"
+        ));
+    }
+    Ok((1..header.len())
+        .map(|k| Series {
+            label: header[k].clone(),
+            points: rows.iter().map(|r| (r[0], r[k])).collect(),
+            markers_only: false,
+        })
+        .collect())
+}
+
+fn print_report(s: &sweep::Sweep) {
+    say(&format!(
+        "{:>12}  {:>8}  {:>12}  {:>12}  {:>12}  {:>8}",
+        s.param, "method", "max Re s", "min damping", "its freq", "cpu s"
+    ));
+    for p in &s.points {
+        match &p.failure {
+            Some(f) => say(&format!(
+                "{:>12}  {:>8}  failed: {f}",
+                short(p.value),
+                p.method.name()
+            )),
+            None => {
+                let top = p.modes.first();
+                say(&format!(
+                    "{:>12}  {:>8}  {:>12}  {:>12}  {:>12}  {:>8}",
+                    short(p.value),
+                    p.method.name(),
+                    short(p.max_real()),
+                    short(p.min_damping_ratio()),
+                    top.map(|m| short(m.im)).unwrap_or_default(),
+                    format!("{:.2}", p.cpu_s)
+                ));
+            }
+        }
+    }
+    for r in s.refinements.iter().filter(|r| r.failure.is_some()) {
+        say(&format!(
+            "refinement at {} failed: {}",
+            short(r.value),
+            r.failure.as_deref().unwrap_or_default()
+        ));
+    }
+    for n in &s.notes {
+        say(&format!("note: {n}"));
+    }
+    for e in &s.edges {
+        say(&format!(
+            "edge: {} = {} (bracket {} .. {}), {} as {} grows",
+            s.param,
+            short(e.value),
+            short(e.bracket.0),
+            short(e.bracket.1),
+            if e.onset { "unstable" } else { "stable" },
+            s.param
+        ));
+    }
+    let ranges = s.unstable_ranges();
+    if ranges.is_empty() {
+        say(&format!(
+            "no unstable range (largest real part at most {} 1/s)",
+            s.threshold
+        ));
+    }
+    for (a, b) in ranges {
+        say(&format!("unstable: {} < {} < {}", short(a), s.param, short(b)));
+    }
+}

@@ -1,0 +1,578 @@
+//! Stability sweeps (`mbd stability`): the characteristic exponents of a model's motion for
+//! each value of a param, by Floquet analysis (THEORY §9.2, [`crate::solve::floquet`]) and/or
+//! by a matrix-pencil fit of a transient (§9.3, [`super::prony`]), and the edges of the unstable
+//! ranges located by bisection.
+//!
+//! Contract: each point compiles the model with `NAME=VALUE` added to the `--set` params, in a
+//! worker thread of [`super::parallel`]; a point that fails (compile or run time) keeps its row
+//! with the failure, never ends the sweep. A point is unstable when its largest real part
+//! exceeds the threshold. Between two grid points of opposite stability, the edge is bisected
+//! `refine` times with the primary method (Floquet when it is among the methods). Must not read
+//! or write files.
+
+use super::prony::{matrix_pencil, PencilSpec};
+use super::{cell, parallel, thread_cpu_seconds};
+use crate::model::{Drive, JointKind};
+use crate::output::charts::{Chart, Series};
+use crate::solve::floquet;
+use crate::solve::modes::c64;
+use crate::Compiled;
+use std::io::{self, Write};
+
+/// Compiles the model with these extra `NAME=VALUE` params; the error is a one-line message.
+pub type CompileWith<'a> = dyn Fn(&[String]) -> Result<Compiled, String> + Sync + 'a;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    Floquet,
+    Prony,
+}
+
+impl Method {
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Floquet => "floquet",
+            Method::Prony => "prony",
+        }
+    }
+}
+
+/// What to sweep and how.
+#[derive(Clone, Debug)]
+pub struct SweepSpec {
+    pub param: String,
+    pub values: Vec<f64>,
+    /// The methods, the primary (edge-finding) one first.
+    pub methods: Vec<Method>,
+    /// Floquet's period (s); `None`: `2 pi / Omega` of the model's prescribed rotor speed.
+    pub period: Option<f64>,
+    /// Prony: the channels fitted (empty: every output channel).
+    pub signals: Vec<String>,
+    /// Prony: the part of the run fitted (s); `None`: from a tenth of the run to its end.
+    pub window: Option<(f64, f64)>,
+    /// Prony: samples over the window (the output is decimated to about this many).
+    pub samples: usize,
+    /// A point is unstable when its largest real part exceeds this (1/s).
+    pub threshold: f64,
+    /// Bisections of each edge.
+    pub refine: usize,
+}
+
+/// Progress of a sweep: evaluations planned (added to the total) or done.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Tick {
+    Planned(usize),
+    Done,
+}
+
+/// The exponents found at one value by one method.
+#[derive(Clone, Debug)]
+pub struct Point {
+    pub value: f64,
+    pub method: Method,
+    /// One per mode: `Im s >= 0` (conjugates merged), largest real part first.
+    pub modes: Vec<c64>,
+    pub failure: Option<String>,
+    pub cpu_s: f64,
+    /// Floquet: the free coordinates and steps per period; Prony: poles kept and the sample
+    /// step.
+    pub detail: String,
+}
+
+impl Point {
+    /// Largest real part (1/s); NaN if the point failed.
+    pub fn max_real(&self) -> f64 {
+        if self.failure.is_some() || self.modes.is_empty() {
+            return f64::NAN;
+        }
+        self.modes
+            .iter()
+            .map(|s| s.re)
+            .fold(f64::NEG_INFINITY, f64::max)
+    }
+
+    /// Smallest damping ratio `-Re s / |s|` over the modes.
+    pub fn min_damping_ratio(&self) -> f64 {
+        if self.failure.is_some() || self.modes.is_empty() {
+            return f64::NAN;
+        }
+        self.modes
+            .iter()
+            .map(|s| {
+                let r = (s.re * s.re + s.im * s.im).sqrt();
+                if r > 0.0 {
+                    -s.re / r
+                } else {
+                    0.0
+                }
+            })
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// An edge of an unstable range, bracketed by the last bisection.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Edge {
+    /// The bracket's midpoint.
+    pub value: f64,
+    pub bracket: (f64, f64),
+    /// True where the motion turns unstable as the param grows.
+    pub onset: bool,
+}
+
+#[derive(Clone, Debug)]
+pub struct Sweep {
+    pub param: String,
+    /// The grid points, by value then method.
+    pub points: Vec<Point>,
+    /// The bisection evaluations (primary method).
+    pub refinements: Vec<Point>,
+    pub edges: Vec<Edge>,
+    pub threshold: f64,
+    /// A failure that stopped the edges from being refined.
+    pub notes: Vec<String>,
+}
+
+/// `START:STOP:STEP` inclusive of STOP (within a millionth of a step).
+pub fn parse_range(text: &str) -> Result<Vec<f64>, String> {
+    let parts: Vec<&str> = text.split(':').map(str::trim).collect();
+    let [a, b, c] = parts[..] else {
+        return Err(format!("the range `{text}` is not START:STOP:STEP"));
+    };
+    let num = |s: &str, what: &str| {
+        s.parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite())
+            .ok_or_else(|| format!("the range's {what} `{s}` is not a number"))
+    };
+    let (start, stop, step) = (num(a, "START")?, num(b, "STOP")?, num(c, "STEP")?);
+    if step == 0.0 || (stop - start) * step < 0.0 {
+        return Err(format!(
+            "the range {text} does not reach STOP from START in steps of STEP"
+        ));
+    }
+    let n = ((stop - start) / step + 1e-6).floor() as usize + 1;
+    if n > 10_000 {
+        return Err(format!("the range {text} has {n} points; at most 10000"));
+    }
+    Ok((0..n).map(|i| start + i as f64 * step).collect())
+}
+
+/// The period of the model's steady rotation: `2 pi / |Omega|` of its revolute joints driven
+/// at a constant rate, if they share one speed.
+pub fn rotor_period(c: &Compiled) -> Result<f64, String> {
+    let until = c.model.solve.until;
+    let mut speeds: Vec<(String, f64)> = Vec::new();
+    for j in &c.model.joints {
+        if let JointKind::Revolute {
+            drive: Drive::Rate { f },
+            ..
+        } = &j.kind
+        {
+            let w = f.eval(0.0);
+            let steady = (0..=20).all(|k| {
+                let t = until * k as f64 / 20.0;
+                (f.eval(t) - w).abs() <= 1e-12 * w.abs().max(1e-300)
+            });
+            if !steady {
+                return Err(format!(
+                    "joint `{}` is driven at a speed that varies in time, so the motion is not periodic; give --period T (s) to analyse one interval, or use --method prony",
+                    j.name
+                ));
+            }
+            if w != 0.0 {
+                speeds.push((j.name.clone(), w.abs()));
+            }
+        }
+    }
+    match speeds.first() {
+        None => Err("the model has no joint driven at a constant speed, so the period is unknown; give --period T (s): for a steady motion any interval works (e.g. a period of its slowest mode), or use --method prony".to_string()),
+        Some((_, w)) => {
+            if let Some((name, w2)) = speeds.iter().find(|(_, w2)| (w2 - w).abs() > 1e-9 * w) {
+                return Err(format!(
+                    "joints `{}` and `{name}` turn at different speeds ({w} and {w2} rad/s); give --period T (s), a common period of both",
+                    speeds[0].0
+                ));
+            }
+            Ok(2.0 * std::f64::consts::PI / w)
+        }
+    }
+}
+
+/// One evaluation: compile with the param at `value`, then the method.
+fn evaluate(
+    spec: &SweepSpec,
+    value: f64,
+    method: Method,
+    compile: &CompileWith,
+    tick: &(dyn Fn(Tick) + Sync),
+) -> Point {
+    let mut point = Point {
+        value,
+        method,
+        modes: Vec::new(),
+        failure: None,
+        cpu_s: f64::NAN,
+        detail: String::new(),
+    };
+    let set = format!("{}={value}", spec.param);
+    let c = match compile(&[set]) {
+        Ok(c) => c,
+        Err(e) => {
+            point.failure = Some(e);
+            return point;
+        }
+    };
+    let start = thread_cpu_seconds();
+    let result = match method {
+        Method::Floquet => floquet_point(spec, &c),
+        Method::Prony => prony_point(spec, c),
+    };
+    point.cpu_s = thread_cpu_seconds() - start;
+    match result {
+        Ok((modes, detail)) => {
+            point.modes = modes;
+            point.detail = detail;
+        }
+        Err(e) => point.failure = Some(e),
+    }
+    tick(Tick::Done);
+    point
+}
+
+/// Exponents with `Im s >= 0`, conjugates merged, largest real part first.
+fn modes_of(exponents: &[c64]) -> Vec<c64> {
+    let mut out: Vec<c64> = Vec::new();
+    let mut taken = vec![false; exponents.len()];
+    for (i, s) in exponents.iter().enumerate() {
+        if taken[i] {
+            continue;
+        }
+        taken[i] = true;
+        let scale = (s.re * s.re + s.im * s.im).sqrt().max(1e-12);
+        // Its conjugate, if present.
+        if let Some(j) = (0..exponents.len()).find(|&j| {
+            !taken[j]
+                && (exponents[j].re - s.re).abs() <= 1e-8 * scale
+                && (exponents[j].im + s.im).abs() <= 1e-8 * scale
+                && s.im != 0.0
+        }) {
+            taken[j] = true;
+        }
+        out.push(c64::new(s.re, s.im.abs()));
+    }
+    out.sort_by(|a, b| b.re.total_cmp(&a.re));
+    out
+}
+
+fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Result<(Vec<c64>, String), String> {
+    let l = c.lowered.as_ref().map_err(|d| d.message.clone())?;
+    let period = match spec.period {
+        Some(t) => t,
+        None => rotor_period(c)?,
+    };
+    let f = floquet::floquet(&l.system, &c.settings(), period, &|| {}).map_err(|f| {
+        let d = c.failure_diagnostic(&f.failure);
+        format!("{} {} (in {})", d.code.as_str(), d.message, f.which())
+    })?;
+    Ok((
+        modes_of(&f.exponents),
+        format!(
+            "{} free coordinates, {} steps of {:.4e} s per period {:.6} s",
+            f.free, f.steps, f.dt, f.period
+        ),
+    ))
+}
+
+fn prony_point(spec: &SweepSpec, mut c: Compiled) -> Result<(Vec<c64>, String), String> {
+    let until = c.model.solve.until;
+    let (from, to) = spec.window.unwrap_or((0.1 * until, until));
+    let dt = c.model.solve.dt;
+    let every = (((to - from) / dt / spec.samples.max(12) as f64).floor() as usize).max(1);
+    c.model.solve.every = every;
+    let need = ((to / dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
+    if need < c.model.solve.steps {
+        c.model.solve.steps = need;
+        c.model.solve.until = need as f64 * dt;
+    }
+    let mut out = Vec::new();
+    let run = crate::run(&c, &mut out);
+    if let Err(f) = &run {
+        return Err(format!("{} {}", f.diagnostic.code.as_str(), f.diagnostic.message));
+    }
+    let text = String::from_utf8(out).map_err(|e| e.to_string())?;
+    let (header, rows) = crate::output::read_csv(&text)?;
+    let columns: Vec<usize> = if spec.signals.is_empty() {
+        (0..header.len()).filter(|&k| header[k] != "t").collect()
+    } else {
+        let mut v = Vec::new();
+        for s in &spec.signals {
+            match header.iter().position(|h| h == s) {
+                Some(k) => v.push(k),
+                None => return Err(format!("the model has no output channel `{s}`")),
+            }
+        }
+        v
+    };
+    let kept: Vec<&Vec<f64>> = rows
+        .iter()
+        .filter(|r| r[0] >= from - 1e-9 * dt && r[0] <= to + 1e-9 * dt)
+        .collect();
+    let signals: Vec<Vec<f64>> = columns
+        .iter()
+        .map(|&k| kept.iter().map(|r| r[k]).collect())
+        .collect();
+    let step = dt * every as f64;
+    let poles = matrix_pencil(&signals, step, &PencilSpec::default())?;
+    let mut modes: Vec<c64> = poles.iter().map(|p| p.s).collect();
+    modes.sort_by(|a, b| b.re.total_cmp(&a.re));
+    Ok((
+        modes,
+        format!(
+            "{} poles from {} signals, {} samples every {:.4e} s over {from}..{to} s",
+            poles.len(),
+            signals.len(),
+            kept.len(),
+            step
+        ),
+    ))
+}
+
+/// Runs the sweep: the grid in parallel, then each edge's bisection (edges in parallel).
+pub fn sweep(spec: &SweepSpec, compile: &CompileWith, tick: &(dyn Fn(Tick) + Sync)) -> Sweep {
+    let jobs: Vec<(f64, Method)> = spec
+        .values
+        .iter()
+        .flat_map(|&v| spec.methods.iter().map(move |&m| (v, m)))
+        .collect();
+    tick(Tick::Planned(jobs.len()));
+    let points: Vec<Point> = parallel(jobs.len(), |k| {
+        evaluate(spec, jobs[k].0, jobs[k].1, compile, tick)
+    })
+    .into_iter()
+    .enumerate()
+    .map(|(k, p)| {
+        p.unwrap_or_else(|| Point {
+            value: jobs[k].0,
+            method: jobs[k].1,
+            modes: Vec::new(),
+            failure: Some("the evaluation stopped on an internal error (a bug in mbd)".into()),
+            cpu_s: f64::NAN,
+            detail: String::new(),
+        })
+    })
+    .collect();
+    let mut notes = Vec::new();
+    let primary = spec.methods[0];
+    let grid: Vec<&Point> = points.iter().filter(|p| p.method == primary).collect();
+    let unstable = |p: &Point| p.max_real() > spec.threshold;
+    // Brackets between neighbours of opposite stability (failed points break the chain).
+    let mut brackets: Vec<(f64, f64, bool)> = Vec::new();
+    for w in grid.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        if a.failure.is_some() || b.failure.is_some() {
+            continue;
+        }
+        if unstable(a) != unstable(b) {
+            brackets.push((a.value, b.value, unstable(a)));
+        }
+    }
+    tick(Tick::Planned(brackets.len() * spec.refine));
+    let refined = parallel(brackets.len(), |k| {
+        let (mut lo, mut hi, lo_unstable) = brackets[k];
+        let mut evals = Vec::new();
+        let mut note = None;
+        for _ in 0..spec.refine {
+            let mid = 0.5 * (lo + hi);
+            let p = evaluate(spec, mid, primary, compile, tick);
+            if let Some(f) = &p.failure {
+                note = Some(format!(
+                    "the edge between {lo} and {hi} was not refined further: at {mid}: {f}"
+                ));
+                evals.push(p);
+                break;
+            }
+            if unstable(&p) == lo_unstable {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+            evals.push(p);
+        }
+        (lo, hi, lo_unstable, evals, note)
+    });
+    let mut edges = Vec::new();
+    let mut refinements = Vec::new();
+    for (lo, hi, lo_unstable, evals, note) in refined.into_iter().flatten() {
+        // `onset` when the motion turns unstable as the param grows.
+        let increasing = hi > lo;
+        edges.push(Edge {
+            value: 0.5 * (lo + hi),
+            bracket: (lo.min(hi), lo.max(hi)),
+            onset: lo_unstable != increasing,
+        });
+        refinements.extend(evals);
+        notes.extend(note);
+    }
+    edges.sort_by(|a, b| a.value.total_cmp(&b.value));
+    refinements.sort_by(|a, b| a.value.total_cmp(&b.value));
+    Sweep {
+        param: spec.param.clone(),
+        points,
+        refinements,
+        edges,
+        threshold: spec.threshold,
+        notes,
+    }
+}
+
+impl Sweep {
+    /// The CSV: `PARAM,max_real,min_damping_ratio,method,freq1,real1,freq2,real2,...` (one row
+    /// per grid value and method; frequencies in rad/s, real parts in 1/s, modes by decreasing
+    /// real part; empty cells where a point failed or has fewer modes).
+    pub fn write_csv(&self, out: &mut dyn Write) -> io::Result<()> {
+        let width = self.points.iter().map(|p| p.modes.len()).max().unwrap_or(0);
+        write!(out, "{},max_real,min_damping_ratio,method", self.param)?;
+        for k in 1..=width {
+            write!(out, ",freq{k},real{k}")?;
+        }
+        writeln!(out)?;
+        for p in &self.points {
+            let finite = |x: f64| x.is_finite().then_some(x);
+            write!(
+                out,
+                "{},{},{},{}",
+                p.value,
+                cell(finite(p.max_real())),
+                cell(finite(p.min_damping_ratio())),
+                p.method.name()
+            )?;
+            for k in 0..width {
+                match (p.failure.is_none(), p.modes.get(k)) {
+                    (true, Some(s)) => write!(out, ",{},{}", s.im, s.re)?,
+                    _ => write!(out, ",,")?,
+                }
+            }
+            writeln!(out)?;
+        }
+        Ok(())
+    }
+
+    /// The unstable ranges of the primary method: from the edges, open at the grid's ends.
+    pub fn unstable_ranges(&self) -> Vec<(f64, f64)> {
+        let primary = match self.points.first() {
+            Some(p) => p.method,
+            None => return Vec::new(),
+        };
+        let grid: Vec<&Point> = self.points.iter().filter(|p| p.method == primary).collect();
+        let (Some(first), Some(last)) = (grid.first(), grid.last()) else {
+            return Vec::new();
+        };
+        let (lo, hi) = (
+            first.value.min(last.value),
+            first.value.max(last.value),
+        );
+        let mut out = Vec::new();
+        let mut open: Option<f64> = None;
+        let starts_unstable = {
+            let low = if first.value <= last.value { first } else { last };
+            low.max_real() > self.threshold
+        };
+        if starts_unstable {
+            open = Some(lo);
+        }
+        for e in &self.edges {
+            // Along increasing values: onset opens, the other closes.
+            let opens = if first.value <= last.value {
+                e.onset
+            } else {
+                !e.onset
+            };
+            if opens {
+                open = Some(e.value);
+            } else if let Some(a) = open.take() {
+                out.push((a, e.value));
+            }
+        }
+        if let Some(a) = open {
+            out.push((a, hi));
+        }
+        out
+    }
+
+    /// Real parts against the param: every mode's as markers, the largest as a line per method,
+    /// the unstable ranges shaded, `reference` series (e.g. multiblade eigenvalues) on top.
+    pub fn chart(&self, title: &str, reference: Vec<Series>) -> Chart {
+        let mut series = Vec::new();
+        let mut methods: Vec<Method> = Vec::new();
+        for p in &self.points {
+            if !methods.contains(&p.method) {
+                methods.push(p.method);
+            }
+        }
+        for m in &methods {
+            let mut all: Vec<&Point> = self
+                .points
+                .iter()
+                .chain(&self.refinements)
+                .filter(|p| p.method == *m && p.failure.is_none())
+                .collect();
+            all.sort_by(|a, b| a.value.total_cmp(&b.value));
+            series.push(Series {
+                label: format!("largest Re s ({})", m.name()),
+                points: all.iter().map(|p| (p.value, p.max_real())).collect(),
+                markers_only: false,
+            });
+            series.push(Series {
+                label: format!("Re s of each mode ({})", m.name()),
+                points: all
+                    .iter()
+                    .flat_map(|p| p.modes.iter().map(move |s| (p.value, s.re)))
+                    .collect(),
+                markers_only: true,
+            });
+        }
+        series.extend(reference);
+        Chart {
+            title: title.to_string(),
+            x_label: self.param.clone(),
+            y_label: "Re s [1/s]".to_string(),
+            log_x: false,
+            log_y: false,
+            series,
+            shaded: self.unstable_ranges(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ranges_include_their_stop() {
+        let v = parse_range("1.0:2.0:0.25").expect("range");
+        assert_eq!(v.len(), 5);
+        assert!((v[4] - 2.0).abs() < 1e-12);
+        assert_eq!(parse_range("3:1:-1").expect("down"), vec![3.0, 2.0, 1.0]);
+        for bad in ["1:2", "1:2:0", "2:1:0.5", "a:2:1", "0:1:1e-9"] {
+            assert!(parse_range(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn conjugate_exponents_are_merged_and_sorted_by_real_part() {
+        let e = [
+            c64::new(-0.1, 2.0),
+            c64::new(0.5, 1.0),
+            c64::new(-0.1, -2.0),
+            c64::new(0.5, -1.0),
+            c64::new(-3.0, 0.0),
+        ];
+        let m = modes_of(&e);
+        assert_eq!(
+            m,
+            vec![c64::new(0.5, 1.0), c64::new(-0.1, 2.0), c64::new(-3.0, 0.0)]
+        );
+    }
+}
