@@ -52,7 +52,18 @@ pub fn simulate_text(
     text: &str,
     overrides: Overrides,
 ) -> Result<Trace, (Trace, String)> {
-    let compiled = match mbd::compile(name, text, &[], overrides) {
+    simulate_text_with(name, text, &[], overrides)
+}
+
+/// `simulate_text` with params set as by `--set NAME=VALUE`.
+pub fn simulate_text_with(
+    name: &str,
+    text: &str,
+    sets: &[&str],
+    overrides: Overrides,
+) -> Result<Trace, (Trace, String)> {
+    let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
+    let compiled = match mbd::compile(name, text, &sets, overrides) {
         Ok(c) => c,
         Err(f) => panic!("{name} does not compile: {:?}", f.diagnostics),
     };

@@ -13,4 +13,5 @@ mod pendulum;
 mod reference;
 mod rigid;
 mod robustness;
+mod rotor;
 mod study;

@@ -1,0 +1,609 @@
+//! The rotor models against independent references (issue 7; PROBLEMS.md P5, P6; THEORY.md
+//! §9.1): the ground-resonance windmill against its nonlinear equations of motion, integrated
+//! here; the spin-up's lag stability and its angular-momentum balance; and the convergence of
+//! the elastic-blade windmill in mesh and time step.
+
+use crate::common::{read, simulate, simulate_text_with, Trace};
+use crate::reference::dopri_breaks;
+use mbd::model::Overrides;
+use std::f64::consts::PI;
+
+// ---------------------------------------------------------------------------------------------
+// The windmill's equations of motion (plain f64: no `mbd` below this line until the tests)
+// ---------------------------------------------------------------------------------------------
+
+/// Blade mass, length and hinge offset, tower-top mass, tower frequency, lag spring (P5).
+const MB: f64 = 20.0;
+const LB: f64 = 2.7;
+const E: f64 = 0.3;
+const MA: f64 = 100.0;
+const OMEGA_T: f64 = 9.26;
+const K_ZETA: f64 = 14.0;
+/// Static moment and inertia of a blade (uniform rod) about its hinge: 27 kg m, 48.6 kg m^2.
+const SB: f64 = MB * LB / 2.0;
+const IB: f64 = MB * LB * LB / 3.0;
+/// Kinks of the pulse.
+const PULSE_BREAKS: [f64; 2] = [0.005, 0.01];
+
+/// The 20 N triangular pulse: 0 N at 0, 20 N at 5 ms, 0 N from 10 ms.
+fn pulse(t: f64) -> f64 {
+    if t <= 0.0 || t >= 0.01 {
+        0.0
+    } else if t <= 0.005 {
+        20.0 * t / 0.005
+    } else {
+        20.0 * (0.01 - t) / 0.005
+    }
+}
+
+/// The planar windmill, re-derived from its Lagrangian (it agrees with THEORY.md §9.1 term by
+/// term, and so with the model's conventions).
+///
+/// Conventions, those of the model: the rotor turns counter-clockwise about +z at the
+/// prescribed rate `Omega`, blade `i` (0-based here, `zeta{i+1}` in the model) at azimuth
+/// `psi_i = Omega t + 2 pi i / N` (blade 0 along +x at t = 0), the lag angle `zeta_i` positive
+/// for a lead, so the blade points along `u(theta_i)`, `theta_i = psi_i + zeta_i`,
+/// `u(a) = (cos a, sin a)`. The hub centre is at `(x, 0)`.
+///
+/// A point at distance `s` along blade `i` sits at `(x, 0) + e u(psi_i) + s u(theta_i)` and moves
+/// with `v = x' e_x + e Omega u'(psi_i) + s theta_i' u'(theta_i)` (`u' = (-sin, cos)`,
+/// `theta_i' = Omega + zeta_i'`). Integrating `|v|^2` over the uniform rod (`mb`, `Sb = mb L/2`,
+/// `Ib = mb L^2/3`; `u(a).u'(b) = sin(b - a)`, `u'(a).u'(b) = cos(b - a)`):
+///
+/// `T_i = mb x'^2/2 + mb e^2 Omega^2/2 + Ib theta_i'^2/2 - mb e Omega x' sin psi_i
+///        - Sb x' theta_i' sin theta_i + e Sb Omega theta_i' cos zeta_i`,
+///
+/// plus `ma x'^2/2` for the tower top, `V = kT x^2/2 + sum k_zeta zeta_i^2/2`, and the pulse's
+/// generalized force `F` on `x`. Lagrange's equation for `zeta_i` (`Omega` constant):
+/// `d/dt(Ib theta' - Sb x' sin theta + e Sb Omega cos zeta) + Sb x' theta' cos theta
+///  + e Sb Omega theta' sin zeta + k_zeta zeta = 0`, which is
+///
+/// `Ib zeta_i'' + k_zeta zeta_i + e Sb Omega^2 sin zeta_i - Sb x'' sin theta_i = 0`;
+///
+/// and for `x` (`M = ma + N mb`; `sum_i cos psi_i = 0` for N >= 2 removes the hinge term):
+///
+/// `M x'' + kT x - Sb sum_i [zeta_i'' sin theta_i + theta_i'^2 cos theta_i] = F`,
+///
+/// exactly the equations of THEORY.md §9.1, with `kT = M omega_T^2`. The mass matrix is an
+/// arrowhead (`M` and `Ib` on the diagonal, `-Sb sin theta_i` coupling `x` to `zeta_i`), solved
+/// exactly at every evaluation by eliminating the `zeta_i''`:
+/// `x'' = (r_x + (Sb/Ib) sum s_i r_i) / (M - (Sb^2/Ib) sum s_i^2)`, `zeta_i'' = (r_i + Sb s_i x'')/Ib`,
+/// with `s_i = sin theta_i` and the right-hand sides `r_x`, `r_i` of the two equations. The
+/// pivot is at least `M - N Sb^2/Ib = 180 - 60 > 0` kg.
+///
+/// State `y = [x, zeta_0 .. zeta_{N-1}, x', zeta_0' .. zeta_{N-1}']`, `D = 2 + 2N`.
+fn windmill_rhs<const D: usize>(omega: f64, t: f64, y: &[f64; D]) -> [f64; D] {
+    let n = (D - 2) / 2;
+    let m = MA + n as f64 * MB;
+    let kt = m * OMEGA_T * OMEGA_T;
+    let mut s = [0.0; D];
+    let mut r = [0.0; D];
+    let mut rx = pulse(t) - kt * y[0];
+    let (mut num, mut den) = (0.0, m);
+    for i in 0..n {
+        let (zeta, rate) = (y[1 + i], y[2 + n + i]);
+        let theta = omega * t + 2.0 * PI * i as f64 / n as f64 + zeta;
+        s[i] = theta.sin();
+        r[i] = -K_ZETA * zeta - E * SB * omega * omega * zeta.sin();
+        rx += SB * (omega + rate).powi(2) * theta.cos();
+        num += SB / IB * s[i] * r[i];
+        den -= SB * SB / IB * s[i] * s[i];
+    }
+    let xdd = (rx + num) / den;
+    let mut dy = [0.0; D];
+    dy[0] = y[1 + n];
+    dy[1 + n] = xdd;
+    for i in 0..n {
+        dy[1 + i] = y[2 + n + i];
+        dy[2 + n + i] = (r[i] + SB * s[i] * xdd) / IB;
+    }
+    dy
+}
+
+/// The windmill from rest (`x = zeta_i = 0`, rates 0, the rotor at `Omega`) at `times`,
+/// integrated by the adaptive Dormand-Prince code, stepping onto the pulse's kinks. Rows:
+/// `[x, zeta_0 .. zeta_{N-1}]`.
+fn windmill_reference(blades: usize, omega: f64, times: &[f64], rtol: f64) -> Vec<Vec<f64>> {
+    fn run<const D: usize>(omega: f64, times: &[f64], rtol: f64) -> Vec<Vec<f64>> {
+        // Displacements are of order 1e-5 m and 1e-4 rad: atol 1e-15 leaves rtol in charge.
+        dopri_breaks(
+            |t, y: &[f64; D]| windmill_rhs(omega, t, y),
+            0.0,
+            [0.0; D],
+            times,
+            &PULSE_BREAKS,
+            rtol,
+            1e-15,
+        )
+        .into_iter()
+        .map(|y| y[..D / 2].to_vec())
+        .collect()
+    }
+    match blades {
+        3 => run::<8>(omega, times, rtol),
+        4 => run::<10>(omega, times, rtol),
+        5 => run::<12>(omega, times, rtol),
+        n => panic!("no reference for {n} blades"),
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Helpers
+// ---------------------------------------------------------------------------------------------
+
+fn max_abs(v: impl IntoIterator<Item = f64>) -> f64 {
+    v.into_iter().map(f64::abs).fold(0.0, f64::max)
+}
+
+/// Largest `|a - b|` over the run relative to the largest `|b|` (the error measure of every
+/// check here: "within p % of the channel's peak amplitude").
+fn rel_error(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    max_abs(a.iter().zip(b).map(|(x, y)| x - y)) / max_abs(b.iter().copied())
+}
+
+fn channels(blades: usize) -> Vec<String> {
+    std::iter::once("x_hub".to_string())
+        .chain((1..=blades).map(|i| format!("zeta{i}")))
+        .collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// 1. The windmill against its nonlinear equations
+// ---------------------------------------------------------------------------------------------
+
+/// Runs `models/windmill.mbd` (as shipped: HHT alpha -0.1, 3 s, dt 0.5 ms unless `dt` is given)
+/// with `blades` and `Omega_bar` set, and returns each channel's error against the reference
+/// (rtol 1e-11, see `windmill_reference_is_converged`).
+fn windmill_errors(blades: usize, omega_bar: f64, dt: Option<f64>) -> Vec<(String, f64)> {
+    let sets = [format!("Omega_bar={omega_bar}"), format!("blades={blades}")];
+    let sets: Vec<&str> = sets.iter().map(String::as_str).collect();
+    let tr = simulate(
+        "models/windmill.mbd",
+        &sets,
+        Overrides {
+            dt,
+            ..Overrides::default()
+        },
+    );
+    let t = tr.col("t");
+    assert!(
+        (t[t.len() - 1] - 3.0).abs() < 1e-9,
+        "the run ends at {}",
+        t[t.len() - 1]
+    );
+    let reference = windmill_reference(blades, omega_bar * OMEGA_T, &t, 1e-11);
+    let errors: Vec<(String, f64)> = channels(blades)
+        .into_iter()
+        .enumerate()
+        .map(|(c, name)| {
+            let want: Vec<f64> = reference.iter().map(|y| y[c]).collect();
+            let e = rel_error(&tr.col(&name), &want);
+            (name, e)
+        })
+        .collect();
+    let list: Vec<String> = errors
+        .iter()
+        .map(|(n, e)| format!("{n} {:.4} %", 100.0 * e))
+        .collect();
+    eprintln!(
+        "windmill, {blades} blades, Omega_bar {omega_bar}, dt {dt:?}: max |error| / peak: {}",
+        list.join(", ")
+    );
+    errors
+}
+
+/// Every channel within 2 % of its peak over the whole 3 s (issue 7's requirement); returns the
+/// largest error.
+fn assert_windmill(blades: usize, omega_bar: f64) -> f64 {
+    let errors = windmill_errors(blades, omega_bar, None);
+    for (name, e) in &errors {
+        assert!(
+            *e < 0.02,
+            "{blades} blades, Omega_bar {omega_bar}: {name} off by {:.3} % of its peak",
+            100.0 * e
+        );
+    }
+    errors.iter().map(|(_, e)| *e).fold(0.0, f64::max)
+}
+
+/// The reference is converged far below anything checked here: tightening its tolerance a
+/// hundredfold (rtol 1e-9 to 1e-11; the output times also cap its step at 0.5 ms) moves no
+/// channel by more than 1e-8 of its peak (measured 7e-14) at Omega_bar = 2, where the unstable
+/// growth amplifies every error over the 3 s.
+#[test]
+fn windmill_reference_is_converged() {
+    let t: Vec<f64> = (0..=6000).map(|k| k as f64 * 5e-4).collect();
+    let omega = 2.0 * OMEGA_T;
+    let coarse = windmill_reference(4, omega, &t, 1e-9);
+    let fine = windmill_reference(4, omega, &t, 1e-11);
+    for c in 0..5 {
+        let a: Vec<f64> = coarse.iter().map(|y| y[c]).collect();
+        let b: Vec<f64> = fine.iter().map(|y| y[c]).collect();
+        let e = rel_error(&a, &b);
+        eprintln!("windmill reference, channel {c}: rtol 1e-9 against 1e-11 {e:.3e} of the peak");
+        assert!(e < 1e-8, "channel {c}: {e:.3e}");
+    }
+}
+
+/// P5 as shipped, four blades, stable (Omega_bar = 1: all roots neutral). Measured: every
+/// channel within 0.006 % of its peak.
+#[test]
+fn windmill_stable_rotor_follows_the_nonlinear_equations() {
+    assert_windmill(4, 1.0);
+}
+
+/// P5 as shipped, four blades, unstable (Omega_bar = 2: the regressing lag mode grows as
+/// exp(1.281 t), about 47-fold over the run). Measured: within 0.010 % of the peak. At dt = 1 ms
+/// the error is 0.090 %: it converges at least at second order (measured 3.1; 3.2 and 3.3 on to
+/// 0.25 and 0.125 ms: HHT's low-frequency dissipation is third order in dt, and its second-order
+/// phase error is small at omega dt < 0.01), so the agreement is convergence to the reference
+/// and not a coincidence of one step size. (dt must divide 5 ms: at 2 ms the pulse is sampled
+/// off its peak, its impulse is 4 % short, and so is every channel.)
+#[test]
+fn windmill_unstable_rotor_follows_the_nonlinear_equations() {
+    let fine = assert_windmill(4, 2.0);
+    let coarse = windmill_errors(4, 2.0, Some(1e-3))
+        .iter()
+        .map(|(_, e)| *e)
+        .fold(0.0, f64::max);
+    let p = (coarse / fine).log2();
+    eprintln!("windmill, Omega_bar 2: observed order {p:.2} between dt 1 ms and 0.5 ms");
+    assert!(p > 1.7, "order {p:.2} ({coarse:.3e}, {fine:.3e})");
+}
+
+/// Three and five blades at Omega_bar = 2, each against the equations with its own N (and
+/// M = ma + N mb, kT = M omega_T^2, as the model builds them). Measured: within 0.012 %.
+#[test]
+fn windmill_with_three_and_five_blades_follows_the_nonlinear_equations() {
+    assert_windmill(3, 2.0);
+    assert_windmill(5, 2.0);
+}
+
+// ---------------------------------------------------------------------------------------------
+// 2. Spin-up (P6)
+// ---------------------------------------------------------------------------------------------
+
+/// Outputs the momentum balance needs: hub azimuth, hub velocity and lag rates.
+const SPINUP_OUTPUTS: &str = "
+output psi = rotor.drive.angle
+output v_hub = tower.tip.velocity.x
+for i in 1..=4 {
+    output zr[i] = rotor.lag[i - 1].rate
+}
+";
+
+fn spinup(t0: f64, dt: Option<f64>) -> Result<Trace, (Trace, String)> {
+    let text = read("models/windmill_spinup.mbd") + SPINUP_OUTPUTS;
+    let set = format!("T0={t0}");
+    simulate_text_with(
+        "models/windmill_spinup.mbd",
+        &text,
+        &[&set],
+        Overrides {
+            dt,
+            ..Overrides::default()
+        },
+    )
+}
+
+/// The spin-up's time histories, blades 0-based.
+struct Spin {
+    t: Vec<f64>,
+    psi: Vec<f64>,
+    omega: Vec<f64>,
+    v_hub: Vec<f64>,
+    zeta: [Vec<f64>; 4],
+    rate: [Vec<f64>; 4],
+}
+
+impl Spin {
+    fn new(tr: &Trace) -> Spin {
+        Spin {
+            t: tr.col("t"),
+            psi: tr.col("psi"),
+            omega: tr.col("Omega_hub"),
+            v_hub: tr.col("v_hub"),
+            zeta: std::array::from_fn(|i| tr.col(&format!("zeta{}", i + 1))),
+            rate: std::array::from_fn(|i| tr.col(&format!("zr{}", i + 1))),
+        }
+    }
+
+    fn azimuth(&self, k: usize, i: usize) -> f64 {
+        self.psi[k] + 2.0 * PI * i as f64 / 4.0
+    }
+
+    /// Magnitude of the one-per-rev (cyclic) lag, `sqrt(zeta_1c^2 + zeta_1s^2)` (§9.1).
+    fn cyclic(&self, k: usize) -> f64 {
+        let (mut c, mut s) = (0.0, 0.0);
+        for i in 0..4 {
+            let a = self.azimuth(k, i);
+            c += 0.5 * self.zeta[i][k] * a.cos();
+            s += 0.5 * self.zeta[i][k] * a.sin();
+        }
+        c.hypot(s)
+    }
+
+    /// Largest cyclic lag and largest `|zeta1 - zeta3|` over `[from, to)`.
+    fn window(&self, from: f64, to: f64) -> (f64, f64) {
+        let ks = (0..self.t.len()).filter(|&k| self.t[k] >= from && self.t[k] < to);
+        ks.fold((0.0, 0.0), |(c, d), k| {
+            (
+                f64::max(c, self.cyclic(k)),
+                f64::max(d, (self.zeta[0][k] - self.zeta[2][k]).abs()),
+            )
+        })
+    }
+
+    /// The rotor's angular momentum about the moving hub centre A, about z (hub massless,
+    /// J_hub = 0). For blade i, with `theta_i' = Omega + zeta_i'` and the point at `s` as in
+    /// `windmill_rhs` (`(r - r_A) = e u(psi_i) + s u(theta_i)`, `u(a) x e_x = -sin a`,
+    /// `u(a) x u'(b) = cos(b - a)`):
+    /// `h_i = mb e^2 Omega + e Sb (Omega + theta_i') cos zeta_i + Ib theta_i'
+    ///        - x' (mb e sin psi_i + Sb sin theta_i)`.
+    fn momentum(&self, k: usize) -> f64 {
+        let (om, v) = (self.omega[k], self.v_hub[k]);
+        (0..4)
+            .map(|i| {
+                let (psi, zeta) = (self.azimuth(k, i), self.zeta[i][k]);
+                let th_dot = om + self.rate[i][k];
+                MB * E * E * om + E * SB * (om + th_dot) * zeta.cos() + IB * th_dot
+                    - v * (MB * E * psi.sin() + SB * (psi + zeta).sin())
+            })
+            .sum()
+    }
+
+    /// The y component of the rotor's linear momentum,
+    /// `p_y = sum_i [mb e Omega cos psi_i + Sb theta_i' cos theta_i]`.
+    fn momentum_y(&self, k: usize) -> f64 {
+        let om = self.omega[k];
+        (0..4)
+            .map(|i| {
+                let (psi, zeta) = (self.azimuth(k, i), self.zeta[i][k]);
+                MB * E * om * psi.cos() + SB * (om + self.rate[i][k]) * (psi + zeta).cos()
+            })
+            .sum()
+    }
+
+    /// Largest `|H_A(t) - H_A(0) - int T + int x' p_y|` over the run, by the trapezoid rule:
+    /// about A, which moves with `v_A = x' e_x`, `dH_A/dt = T(t) - (v_A x m v_G)_z
+    /// = T(t) - x' p_y` (the hub's joint forces act at A; only the drive torque has a moment).
+    /// Returns it with the largest `|int x' p_y|` (the size of the correction).
+    fn balance(&self, t0: f64) -> (f64, f64) {
+        let torque = |t: f64| t0 * (t / 0.5).clamp(0.0, 1.0);
+        let h0 = self.momentum(0);
+        let (mut impulse, mut correction, mut worst, mut largest) = (0.0, 0.0, 0.0f64, 0.0f64);
+        for k in 1..self.t.len() {
+            let dt = self.t[k] - self.t[k - 1];
+            impulse += 0.5 * dt * (torque(self.t[k]) + torque(self.t[k - 1]));
+            correction += 0.5
+                * dt
+                * (self.v_hub[k] * self.momentum_y(k) + self.v_hub[k - 1] * self.momentum_y(k - 1));
+            worst = worst.max((self.momentum(k) - h0 - impulse + correction).abs());
+            largest = largest.max(correction.abs());
+        }
+        (worst, largest)
+    }
+}
+
+fn spin(t0: f64, dt: Option<f64>) -> Spin {
+    match spinup(t0, dt) {
+        Ok(tr) => Spin::new(&tr),
+        Err((tr, m)) => panic!(
+            "the spin-up at T0 = {t0} N m, dt {dt:?} failed at t = {:?} s: {m}",
+            tr.col("t").last()
+        ),
+    }
+}
+
+/// The lag windows: early, after the pulse's forced response (0.1 s) and before the rotor
+/// reaches the band (Omega_bar = 1.1774 at 0.42 s for T0 = 2.5 kN m, 1.12 s for 0.5 kN m), and
+/// late, the last half second. Returns (late / early) of the cyclic lag and of |zeta1 - zeta3|.
+fn lag_growth(s: &Spin, t0: f64) -> (f64, f64) {
+    let early = s.window(0.1, 0.4);
+    let late = s.window(4.0, 4.5 + 1e-9);
+    let growth = (late.0 / early.0, late.1 / early.1);
+    let table: Vec<String> = (0..9)
+        .map(|w| {
+            let (a, b) = (w as f64 * 0.5, w as f64 * 0.5 + 0.5);
+            format!("{:.2e}", s.window(a.max(0.1), b).0)
+        })
+        .collect();
+    eprintln!(
+        "spin-up T0 {t0} N m: cyclic lag, max per half second from 0.1 s: {}; late / early: cyclic {:.2}, zeta1 - zeta3 {:.2}",
+        table.join(" "),
+        growth.0,
+        growth.1
+    );
+    growth
+}
+
+/// Checks the angular-momentum balance of `Spin::balance` and the mean rotor speed it implies;
+/// returns (residual, largest correction). The balance's own error: the torque is linear in time
+/// between samples (its kink at 0.5 s is a sample), so its trapezoid is exact; the trapezoid of
+/// `x' p_y` (frequencies below 40 rad/s, h = 0.5 ms) is off by about (40 h)^2 / 12 = 3e-5 of
+/// the correction, which is below 5e-3 N m s. What remains is the solver's: HHT does not
+/// conserve angular momentum exactly, its error is second order in dt (see the T0 = 2.5 kN m
+/// test), and Newton's tolerance adds far less. Bound: 2e-6 of the final momentum.
+fn check_momentum(s: &Spin, t0: f64) -> (f64, f64) {
+    let (residual, correction) = s.balance(t0);
+    let last = s.t.len() - 1;
+    let h_end = s.momentum(last);
+    let impulse = t0 * (s.t[last] - 0.25);
+    eprintln!(
+        "spin-up T0 {t0} N m: H_A {:.4} -> {h_end:.4} N m s (torque impulse {impulse:.1}); \
+         balance residual {residual:.3e} N m s ({:.2e} of H), largest |int x' p_y| {correction:.3e}",
+        s.momentum(0),
+        residual / h_end
+    );
+    assert!(
+        residual < 2e-6 * h_end,
+        "T0 {t0}: angular-momentum balance off by {residual:.3e} N m s of {h_end:.3e}"
+    );
+    // The rotor speed follows the impulse over the polar inertia (mb e^2 + 2 e Sb + Ib per blade,
+    // 266.4 kg m^2): the hub's rate swings with the collective lag (the hub is massless), so
+    // compare means over the last half second. Within 1 %: the collective lag (a few hundredths
+    // of a radian) changes the inertia by less than 1e-3, and the window holds several of its
+    // cycles.
+    let j = 4.0 * (MB * E * E + 2.0 * E * SB + IB);
+    let ks: Vec<usize> = (0..s.t.len()).filter(|&k| s.t[k] >= 4.0).collect();
+    let mean = |f: &dyn Fn(usize) -> f64| ks.iter().map(|&k| f(k)).sum::<f64>() / ks.len() as f64;
+    let h0 = s.momentum(0);
+    let measured = mean(&|k| s.omega[k]);
+    let predicted = mean(&|k| (h0 + t0 * (s.t[k] - 0.25)) / j);
+    eprintln!(
+        "spin-up T0 {t0} N m: mean rotor speed over [4, 4.5] s {measured:.3} rad/s, \
+         (H0 + impulse) / J {predicted:.3} rad/s"
+    );
+    assert!(
+        (measured / predicted - 1.0).abs() < 0.01,
+        "T0 {t0}: rotor speed {measured:.3} rad/s, impulse predicts {predicted:.3}"
+    );
+    (residual, correction)
+}
+
+/// P6, T0 = 2.5 kN m: the rotor crosses the unstable band (Omega_bar 1.18 to 2.32) between
+/// about 0.42 s and 1.55 s. With frozen coefficients the regressing mode can grow by
+/// exp(int max(Re s, 0) dt) = exp(1.25) = 3.5 on the way (Re s from the MBC equations of
+/// THEORY.md §9.1 at the mean rotor speed (H0 + torque impulse) / J; the same estimate gives 48
+/// for T0 = 0.5 kN m), then it is neutral again. So the late cyclic lag must stay below 3.5
+/// times the early one (measured 1.68, zeta1 - zeta3 1.71; 2.6 at the largest, near 2 s) and
+/// must not grow over the last second (measured ratio 0.89; bound 1.05). A running instability
+/// leaves both far behind (T0 = 0.5 kN m: 27).
+/// The hub being massless, the torque reaches the blades only through their hinges: the
+/// collective lag reaches -0.48 rad at 0.5 s and oscillates (about 40 rad/s), and the hub's rate
+/// swings by up to 0.5 omega_T with it; the cyclic lag and zeta1 - zeta3 do not see it.
+/// The angular-momentum balance holds to 2e-6 of H (measured 9.6e-7); its residual is the
+/// integrator's: halving dt divides it by 3.8 (second order).
+#[test]
+fn spinup_high_torque_crosses_the_band_without_instability() {
+    let s = spin(2500.0, None);
+    let (cyclic, differential) = lag_growth(&s, 2500.0);
+    assert!(cyclic < 3.5, "cyclic lag grew {cyclic:.2}-fold");
+    assert!(
+        differential < 3.5,
+        "zeta1 - zeta3 grew {differential:.2}-fold"
+    );
+    let (prev, late) = (s.window(2.5, 3.5).0, s.window(3.5, 4.5 + 1e-9).0);
+    eprintln!("spin-up T0 2500 N m: cyclic lag max [2.5, 3.5) {prev:.3e}, [3.5, 4.5] {late:.3e}");
+    assert!(
+        late < 1.05 * prev,
+        "the cyclic lag still grows: {prev:.3e} then {late:.3e}"
+    );
+    let (coarse, _) = check_momentum(&s, 2500.0);
+    let half = spin(2500.0, Some(2.5e-4));
+    let (fine, _) = check_momentum(&half, 2500.0);
+    let p = (coarse / fine).log2();
+    eprintln!("spin-up T0 2500 N m: balance residual {coarse:.3e} at 0.5 ms, {fine:.3e} at 0.25 ms: order {p:.2}");
+    assert!(
+        p > 1.7,
+        "the balance residual does not converge: order {p:.2}"
+    );
+}
+
+/// P6, T0 = 0.5 kN m: the rotor enters the band at about 1.1 s and is still in it at 4.5 s
+/// (Omega_bar about 1.86): the frozen-coefficient growth is exp(3.87) = 48. The cyclic lag must
+/// grow more than tenfold (measured 27, zeta1 - zeta3 20). Newton converges throughout at the
+/// shipped dt (the cyclic lag stays below 3e-3 rad). The angular-momentum balance holds to 2e-6
+/// of H (measured 3.2e-8), and here the tower-motion correction `int x' p_y` (4.1e-3 N m s) is
+/// 28 times the residual: the check sees it.
+#[test]
+fn spinup_low_torque_excites_the_instability() {
+    let s = spin(500.0, None);
+    let (cyclic, differential) = lag_growth(&s, 500.0);
+    assert!(cyclic > 10.0, "cyclic lag grew only {cyclic:.2}-fold");
+    assert!(
+        differential > 10.0,
+        "zeta1 - zeta3 grew only {differential:.2}-fold"
+    );
+    let (residual, correction) = check_momentum(&s, 500.0);
+    assert!(
+        residual < 0.1 * correction,
+        "residual {residual:.3e} against a correction of {correction:.3e}"
+    );
+}
+
+// ---------------------------------------------------------------------------------------------
+// 3. The elastic-blade windmill converges in mesh and time step
+// ---------------------------------------------------------------------------------------------
+
+fn elastic(elements: usize, dt: f64) -> Trace {
+    let set = format!("elements={elements}");
+    simulate(
+        "models/windmill_elastic.mbd",
+        &[&set],
+        Overrides {
+            dt: Some(dt),
+            until: Some(1.0),
+            ..Overrides::default()
+        },
+    )
+}
+
+/// The channel `name` sampled every millisecond.
+fn every_ms(tr: &Trace, name: &str) -> Vec<f64> {
+    let t = tr.col("t");
+    let v = tr.col(name);
+    (0..t.len())
+        .filter(|&k| {
+            let ms = t[k] * 1e3;
+            (ms - ms.round()).abs() < 1e-6
+        })
+        .map(|k| v[k])
+        .collect()
+}
+
+/// Successive differences (max |difference| over the run / the finer run's peak) of `x_hub` and
+/// `zeta1` along a sequence of runs.
+fn successive(runs: &[Trace]) -> [[f64; 2]; 2] {
+    let ch = ["x_hub", "zeta1"];
+    std::array::from_fn(|c| {
+        let v: Vec<Vec<f64>> = runs.iter().map(|tr| every_ms(tr, ch[c])).collect();
+        [rel_error(&v[0], &v[1]), rel_error(&v[1], &v[2])]
+    })
+}
+
+/// The elastic-blade windmill (Omega_bar 1.1, two quadratic elements per blade) over 1 s at
+/// dt = 0.5, 0.25, 0.125 ms: second order. The differences between successive runs shrink with
+/// an observed order within 0.3 of 2 (measured 1.91 for x_hub, 1.88 for zeta1). From 1 ms the
+/// first difference is not yet asymptotic (orders 1.35 and 1.72). The lag channel's time-step
+/// error is large: mostly collective (the same on every blade), it comes from the phase error
+/// of the elastic blades' rigid rotation, O((Omega dt)^2), which loads the collective lag mode;
+/// at the shipped 0.5 ms it is about a quarter of zeta1's (small, 1e-4 rad) peak.
+#[test]
+fn elastic_windmill_converges_in_dt() {
+    let runs: Vec<Trace> = [5e-4, 2.5e-4, 1.25e-4]
+        .iter()
+        .map(|&dt| elastic(2, dt))
+        .collect();
+    let d = successive(&runs);
+    for (c, name) in ["x_hub", "zeta1"].iter().enumerate() {
+        let p = (d[c][0] / d[c][1]).log2();
+        eprintln!(
+            "elastic windmill {name}, dt 0.5 / 0.25 / 0.125 ms: differences {:.3e}, {:.3e} of the peak, order {p:.2}",
+            d[c][0], d[c][1]
+        );
+        assert!((p - 2.0).abs() < 0.3, "{name}: order {p:.2}");
+    }
+}
+
+/// The same over 1 s at dt = 0.5 ms with 2, 4 and 8 quadratic elements per blade: the
+/// differences between successive meshes shrink, by a factor of more than 3 (measured 4.9 for
+/// x_hub, 6.4 for zeta1). With 16 elements zeta1's difference shrinks only by 2.3 more (1.1e-3
+/// of its peak, the same at dt = 0.25 ms): not checked.
+#[test]
+fn elastic_windmill_converges_in_mesh() {
+    let runs: Vec<Trace> = [2, 4, 8].iter().map(|&n| elastic(n, 5e-4)).collect();
+    let d = successive(&runs);
+    for (c, name) in ["x_hub", "zeta1"].iter().enumerate() {
+        let ratio = d[c][0] / d[c][1];
+        eprintln!(
+            "elastic windmill {name}, 2 / 4 / 8 elements: differences {:.3e}, {:.3e} of the peak, ratio {ratio:.2}",
+            d[c][0], d[c][1]
+        );
+        assert!(
+            ratio > 3.0,
+            "{name}: mesh differences shrink only {ratio:.2}-fold"
+        );
+    }
+}
