@@ -412,13 +412,80 @@ fn conditions_and_parts() {
             "bob.position",
             "x = bob.position.x",
             "zeta[i] = rotor.lag[i - 1].angle",
+            "zeta = multiblade(rotor.lag, azimuth = rotor.drive)",
+            "cm = center_of_mass(rotor)",
+            "center_of_mass(rotor).x",
         ],
-        &["x =", "= bob", "x = 3"],
+        &["x =", "= bob", "x = 3", "cm = center_of_mass(rotor) .x"],
     );
     check(
         Rule::index,
         &["[i]", "[i - 1]", "[ 2 ]"],
         &["[]", "[i", "i]"],
+    );
+}
+
+#[test]
+fn output_functions() {
+    check(
+        Rule::output_call,
+        &[
+            "multiblade(rotor.lag, azimuth = rotor.drive)",
+            "multiblade( rotor.lag ,\n azimuth=rotor.drive )",
+            "multiblade(rotor.lag.angle, rotor.drive)",
+            "multiblade(lag, azimuth = drive)",
+            "center_of_mass(rotor)",
+            "center_of_mass(rotor).x",
+            "center_of_mass(rotor.blade[2]).velocity.y",
+            "center_of_mass(of = rotor)",
+            "center_of_mass()",
+        ],
+        &[
+            // A space before `(` or around a dot, as in a path.
+            "center_of_mass (rotor)",
+            "center_of_mass(rotor) .x",
+            "center_of_mass(rotor). x",
+            // Arguments are references, not expressions or bare values.
+            "multiblade(rotor.lag, azimuth = 3)",
+            "multiblade(rotor.lag, azimuth = rotor.drive + 1)",
+            "center_of_mass(1 kg)",
+            "center_of_mass((rotor))",
+            // Malformed calls.
+            "center_of_mass(rotor",
+            "center_of_mass(rotor,)",
+            "center_of_mass(, rotor)",
+            "multiblade(rotor.lag, azimuth =)",
+            "multiblade(rotor.lag, = rotor.drive)",
+            "center_of_mass(rotor).",
+            "center_of_mass(rotor).1",
+            "center_of_mass(rotor)[1]",
+            "center_of_mass(rotor)(x)",
+            "a.center_of_mass(rotor)",
+            "output(rotor)",
+            "(rotor)",
+        ],
+    );
+    check(
+        Rule::output_arg,
+        &[
+            "rotor.lag",
+            "azimuth = rotor.drive",
+            "of=rotor",
+            "rotor.blade[i - 1]",
+        ],
+        &["azimuth =", "= rotor", "3", "azimuth = 3 m", "a = b = c"],
+    );
+    check(
+        Rule::output_decl,
+        &[
+            "output zeta = multiblade(rotor.lag, azimuth = rotor.drive), x = hub.position.x",
+            "output center_of_mass(rotor), rotor_cm = center_of_mass(rotor).velocity",
+        ],
+        &[
+            "output zeta = multiblade(rotor.lag, azimuth = rotor.drive",
+            "output zeta = multiblade (rotor.lag)",
+            "output = center_of_mass(rotor)",
+        ],
     );
 }
 

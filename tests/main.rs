@@ -9,6 +9,7 @@ mod docs;
 mod fet;
 mod grammar;
 mod models;
+mod outputs;
 mod pendulum;
 mod reference;
 mod rigid;

@@ -107,6 +107,12 @@ fn problem_models_expose_their_params_and_channels() {
         .collect();
     let mut spin = bars.clone();
     spin.push("torque");
+    let (mill, spinup) = (
+        windmill_channels("x_hub", 4),
+        windmill_channels("Omega_hub", 4),
+    );
+    let mill: Vec<&str> = mill.iter().map(String::as_str).collect();
+    let spinup: Vec<&str> = spinup.iter().map(String::as_str).collect();
     let cases: &[(&str, &[&str], Vec<&str>)] = &[
         (
             "models/pendulum.mbd",
@@ -137,18 +143,14 @@ fn problem_models_expose_their_params_and_channels() {
         (
             "models/windmill.mbd",
             &["Omega_bar", "blades", "omega_T", "k_zeta", "e"],
-            vec!["x_hub", "zeta1", "zeta2", "zeta3", "zeta4"],
+            mill.clone(),
         ),
         (
             "models/windmill_elastic.mbd",
             &["Omega_bar", "blades", "omega_T", "k_zeta", "e"],
-            vec!["x_hub", "zeta1", "zeta2", "zeta3", "zeta4"],
+            mill.clone(),
         ),
-        (
-            "models/windmill_spinup.mbd",
-            &["T0", "J_hub"],
-            vec!["Omega_hub", "zeta1", "zeta2", "zeta3", "zeta4"],
-        ),
+        ("models/windmill_spinup.mbd", &["T0", "J_hub"], spinup),
     ];
     for (path, params, channels) in cases {
         let c = compile(path, &[]);
@@ -162,6 +164,21 @@ fn problem_models_expose_their_params_and_channels() {
     }
 }
 
+/// The windmills' channels: the hub's, the lag angles `zeta1`..`zetaN`, their multiblade
+/// coordinates (added 2026-11-22, issue 7 items 3 and 4) and the rotor's centre of mass.
+fn windmill_channels(hub: &str, n: usize) -> Vec<String> {
+    let mut out: Vec<String> = vec![hub.to_string()];
+    out.extend((1..=n).map(|i| format!("zeta{i}")));
+    let coleman: &[&str] = match n {
+        3 => &["0", "1c", "1s"],
+        4 => &["0", "1c", "1s", "d"],
+        _ => &["0", "1c", "1s", "2c", "2s"],
+    };
+    out.extend(coleman.iter().map(|c| format!("zeta_{c}")));
+    out.extend(["x", "y", "z"].iter().map(|c| format!("rotor_cm.{c}")));
+    out
+}
+
 #[test]
 fn windmill_builds_n_blades_spinning_about_the_hub() {
     for n in [3usize, 4, 5] {
@@ -170,10 +187,7 @@ fn windmill_builds_n_blades_spinning_about_the_hub() {
             let set_t = format!("elastic_tower={elastic_tower}");
             let c = compile("models/windmill.mbd", &[&set_n, &set_t]);
             let m = &c.model;
-            let want: Vec<String> = std::iter::once("x_hub".to_string())
-                .chain((1..=n).map(|i| format!("zeta{i}")))
-                .collect();
-            assert_eq!(columns(m), want);
+            assert_eq!(columns(m), windmill_channels("x_hub", n), "{n} blades");
             let (e, l, omega) = (0.3, 2.7, 9.26);
             for k in 0..n {
                 let b = m

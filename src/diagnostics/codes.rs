@@ -86,7 +86,9 @@ position, velocity and acceleration (and their .x .y .z components), rigid bodie
 angular_velocity, angular_acceleration, rotation and crv; markers and beam points provide \
 position, velocity and acceleration; joints provide force, moment and violation, revolute joints \
 angle and rate, prismatic joints displacement and speed; `kinetic_energy`, `potential_energy` \
-and `total_energy` are model outputs.";
+and `total_energy` are model outputs. After `center_of_mass(...)` may follow `.position`, \
+`.velocity` or `.acceleration` and a component `.x .y .z`; `multiblade(...)` takes none (each \
+coordinate is a column).";
     E0213 = "E0213", "invalid value",
         "A value is outside its allowed range or not finite: a negative time step, an HHT alpha \
 outside [-1/3, 0], a division by zero, the square root of a negative number.";
@@ -128,6 +130,28 @@ where a body is needed, or a body used as a number. Markers are written `body`, 
         "A declaration has parts its kind does not take, or lacks parts it needs: a `force` needs \
 `on MARKER = value`, a `spring` connects two markers `(a, b)`, a `rigid` body takes neither, and \
 a section gives either its full 6x6 `stiffness` or the diagonal stiffnesses, not both.";
+    E0225 = "E0225", "unknown output function or wrong arguments",
+        "An output names a function that does not exist, or passes it arguments it does not take. \
+The output functions are `multiblade(BLADES, azimuth = JOINT)` (the multiblade coordinates of \
+the angles of a family of revolute joints) and `center_of_mass(OF)` (the centre of mass of a \
+body, a beam, a component instance or a family of them). Arguments are references, given in \
+that order or by name; positional arguments come before named ones, and each is given once: \
+`output zeta = multiblade(rotor.lag, azimuth = rotor.drive)`.";
+    E0226 = "E0226", "multiblade blades are not a family of revolute joints",
+        "The first argument of `multiblade` names the blades' coordinates: an indexed family of \
+revolute joints, written without an index (`rotor.lag`, or `rotor.lag.angle`), whose angles \
+are the blade coordinates zeta_k. Member k of the family (in index order, without gaps) is \
+blade k, at azimuth psi + 2 pi k / N. A single joint (`rotor.lag[0]`), a family of bodies or of \
+other joints, or a family of fewer than 2 members has no multiblade coordinates.";
+    E0227 = "E0227", "multiblade azimuth missing or not a revolute joint",
+        "`multiblade` needs the rotor azimuth psi: `azimuth = JOINT` names the revolute joint the \
+rotor turns on (`rotor.drive` in stdlib::rotor), whose angle is psi, zero at t = 0. Blade k \
+is taken at psi + 2 pi k / N, so blade 0 must be the one at psi = 0.";
+    E0228 = "E0228", "centre of mass of something without mass",
+        "`center_of_mass(OF)` weighs a body, a beam, a component instance (every body and beam \
+declared in it, recursively, with the concentrated masses they carry) or a family of them. \
+What it names is none of these (a joint, a param, a quantity), declares no bodies, or has no \
+mass at all (a massless hub), so it has no centre of mass.";
     E0301 = "E0301", "joint connects a body to itself",
         "Both markers of a joint are on the same body, so the joint constrains nothing. Connect it \
 to another body or to ground.";

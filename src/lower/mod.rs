@@ -209,8 +209,12 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
             })),
         }
     }
+    // Bodies are elements 0..nb; each beam lowers to a run of elements (with its masses).
+    let mut beam_elements = Vec::new();
     for (bi, b) in model.beams.iter().enumerate() {
+        let first = elements.len();
         beams::beam(&lw, bi, b, &mut elements, &mut initial);
+        beam_elements.push(first..elements.len());
     }
     // Joints: element index of each, and whether each multiplier is a rate row.
     let mut joint_element = Vec::new();
@@ -275,7 +279,7 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
         .iter()
         .map(|o| Channel {
             column: o.column.clone(),
-            probe: probe(&lw, &o.probe, &joint_element),
+            probe: probe(&lw, &o.probe, &joint_element, &beam_elements),
         })
         .collect();
     let system = System {
@@ -310,7 +314,12 @@ fn rigid(b: &Body, d: &[usize], node: usize, gravity: [f64; 3]) -> RigidBody {
     }
 }
 
-fn probe(lw: &Lower, p: &ModelProbe, joint_element: &[usize]) -> Probe {
+fn probe(
+    lw: &Lower,
+    p: &ModelProbe,
+    joint_element: &[usize],
+    beam_elements: &[std::ops::Range<usize>],
+) -> Probe {
     let quantity = |q: BodyQuantity| match q {
         BodyQuantity::Position => ProbeQuantity::Position,
         BodyQuantity::Velocity => ProbeQuantity::Velocity,
@@ -321,6 +330,30 @@ fn probe(lw: &Lower, p: &ModelProbe, joint_element: &[usize]) -> Probe {
         BodyQuantity::Crv => ProbeQuantity::Crv,
     };
     match *p {
+        ModelProbe::Multiblade {
+            ref blades,
+            azimuth,
+            coordinate,
+        } => Probe::Multiblade {
+            blades: blades.iter().map(|&j| joint_element[j]).collect(),
+            azimuth: joint_element[azimuth],
+            coordinate,
+        },
+        ModelProbe::CenterOfMass {
+            ref bodies,
+            ref beams,
+            quantity: q,
+            component,
+        } => Probe::CenterOfMass {
+            // Bodies were lowered first, one element each: body `b` is element `b`.
+            elements: bodies
+                .iter()
+                .copied()
+                .chain(beams.iter().flat_map(|&b| beam_elements[b].clone()))
+                .collect(),
+            quantity: quantity(q),
+            component,
+        },
         ModelProbe::Body {
             body,
             quantity: q,

@@ -570,7 +570,9 @@ impl Builder<'_> {
             }
             Ref::Component(c) => return not_marker(self, format!("component `{}`", c.name.name)),
             Ref::Binding(b) => return not_marker(self, format!("`{}`", self.env.bindings[b].name)),
-            Ref::Builtin(_) => return not_marker(self, format!("`{}`", m.path.text())),
+            Ref::Builtin(_) | Ref::Family(_) => {
+                return not_marker(self, format!("`{}`", m.path.text()))
+            }
         };
         let text = self.env.decls[d].name.clone();
         let built = self.built[d];

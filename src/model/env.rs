@@ -131,6 +131,9 @@ pub enum Ref {
     Component(Rc<Component>),
     /// `t`, `pi`, `x`, `y`, `z`.
     Builtin(Value),
+    /// A whole indexed family, its members in index order (only from
+    /// [`Env::resolve_family`]).
+    Family(Vec<(i64, Member)>),
 }
 
 const BUILTINS: &[&str] = &["t", "pi", "x", "y", "z", "true", "false"];
@@ -168,6 +171,9 @@ pub struct Env {
     pub errors: Vec<Diagnostic>,
     /// Nesting of on-demand evaluations, to stop runaway self-reference.
     depth: usize,
+    /// Set by [`Env::resolve_family`]: a family named without an index resolves to
+    /// [`Ref::Family`] instead of asking for an index.
+    families: bool,
 }
 
 impl Env {
@@ -534,6 +540,20 @@ impl Env {
         r
     }
 
+    /// Like [`Env::resolve`], but a family named without an index (`rotor.lag`) is a
+    /// [`Ref::Family`], for output functions that take every member.
+    pub fn resolve_family(
+        &mut self,
+        scope: ScopeId,
+        segs: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
+        let was = std::mem::replace(&mut self.families, true);
+        let r = self.resolve(scope, segs, span);
+        self.families = was;
+        r
+    }
+
     fn resolve_inner(
         &mut self,
         scope: ScopeId,
@@ -624,6 +644,14 @@ impl Env {
                 return self.enter_instance(s, rest, span);
             }
             Named::Family(map) => {
+                if seg.index.is_none() && self.families {
+                    for m in map.values() {
+                        if let Member::Decl(d) = m {
+                            self.decls[*d].used = true;
+                        }
+                    }
+                    return Ok((Ref::Family(map.into_iter().collect()), rest.to_vec()));
+                }
                 let Some((i, ispan)) = seg.index else {
                     let (lo, hi) = (
                         map.keys().next().copied().unwrap_or(0),
@@ -869,6 +897,14 @@ impl Names for Cx<'_> {
                 )
                 .at(path.span, "used as a value")
                 .hint("use one of its exported names"));
+            }
+            Ref::Family(_) => {
+                return Err(Diagnostic::error(
+                    Code::E0214,
+                    "an indexed family is not a value; say which member",
+                )
+                .at(path.span, "used as a value")
+                .hint("write `NAME[i]`"));
             }
             Ref::Component(c) => {
                 return Err(Diagnostic::error(

@@ -170,6 +170,9 @@ impl Builder<'_> {
         match probe {
             Probe::Body { quantity, .. } | Probe::Point { quantity, .. } => Some(body(*quantity)),
             Probe::Energy { .. } => Some(Dim::FORCE.times(Dim::LENGTH)),
+            Probe::CenterOfMass { quantity, .. } => Some(body(*quantity)),
+            // Angles are dimensionless, and so are their multiblade coordinates.
+            Probe::Multiblade { .. } => Some(Dim::NONE),
             Probe::Joint {
                 joint, quantity, ..
             } => {

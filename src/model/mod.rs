@@ -7,12 +7,14 @@
 mod beams;
 mod bodies;
 mod build;
+mod center_of_mass;
 mod connect;
 pub mod dofs;
 mod elaborate;
 mod env;
 pub mod eval;
 mod exact;
+mod output_calls;
 mod outputs;
 mod settings;
 pub mod topology;
@@ -24,6 +26,7 @@ pub use dofs::DofMap;
 pub use eval::Value;
 
 use crate::runtime::timefn::TimeFn;
+pub use crate::runtime::Coleman;
 use crate::source::Span;
 use serde::Serialize;
 
@@ -390,6 +393,22 @@ pub enum Probe {
     },
     Energy {
         kind: EnergyKind,
+    },
+    /// A multiblade (Coleman) coordinate of the angles of the revolute joints `blades` (blade
+    /// k is member k of the family in index order), with the rotor azimuth the angle of the
+    /// revolute joint `azimuth`.
+    Multiblade {
+        blades: Vec<usize>,
+        azimuth: usize,
+        coordinate: Coleman,
+    },
+    /// The centre of mass of bodies and beams, each with the concentrated masses it carries:
+    /// its position, velocity or acceleration.
+    CenterOfMass {
+        bodies: Vec<usize>,
+        beams: Vec<usize>,
+        quantity: BodyQuantity,
+        component: usize,
     },
 }
 

@@ -4,10 +4,10 @@ use super::build::{Builder, Built};
 use super::env::{Ref, ScopeId, Seg};
 use super::*;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
-use crate::syntax::ast::OutputItem;
+use crate::syntax::ast::{OutputItem, OutputTarget, Path};
 use std::collections::HashMap;
 
-const AXES: [&str; 3] = ["x", "y", "z"];
+pub(super) const AXES: [&str; 3] = ["x", "y", "z"];
 const CRV: [&str; 3] = ["c1", "c2", "c3"];
 const DCM: [&str; 9] = [
     "r11", "r12", "r13", "r21", "r22", "r23", "r31", "r32", "r33",
@@ -32,7 +32,11 @@ impl Builder<'_> {
         columns.insert("t".to_string(), Span::default());
         for (item, scope) in items {
             let scope = *scope;
-            let Some(probes) = self.probes(scope, item) else {
+            let probes = match &item.target {
+                OutputTarget::Path(path) => self.probes(scope, path),
+                OutputTarget::Call(call) => self.call_probes(scope, call),
+            };
+            let Some(probes) = probes else {
                 continue;
             };
             let base = match &item.name {
@@ -47,23 +51,18 @@ impl Builder<'_> {
                     },
                     None => n.ident.name.clone(),
                 },
-                None => item.path.text().replace("[..]", "").replace("(..)", ""),
-            };
-            let base = if item.name.is_none() {
-                self.written(scope, item).unwrap_or(base)
-            } else {
-                base
+                None => match &item.target {
+                    OutputTarget::Path(path) => self
+                        .written(scope, path)
+                        .unwrap_or_else(|| path.text().replace("[..]", "").replace("(..)", "")),
+                    OutputTarget::Call(call) => self.call_column(scope, call),
+                },
             };
             // Outputs declared in a component instance are named after it: `rotor.tension`.
             let home = self.env.scopes[scope].home;
             let base = format!("{}{base}", self.env.scopes[home].prefix);
-            let n = probes.len();
             for (suffix, probe) in probes {
-                let column = if n == 1 {
-                    base.clone()
-                } else {
-                    format!("{base}.{suffix}")
-                };
+                let column = format!("{base}{suffix}");
                 if let Some(first) = columns.get(&column) {
                     let mut d = Diagnostic::error(
                         Code::E0203,
@@ -88,8 +87,8 @@ impl Builder<'_> {
     }
 
     /// The path as the column name: indices evaluated, `rotor.lag[1].angle`.
-    fn written(&mut self, scope: ScopeId, item: &OutputItem) -> Option<String> {
-        let segs = self.env.segs(scope, &item.path).ok()?;
+    pub(super) fn written(&mut self, scope: ScopeId, path: &Path) -> Option<String> {
+        let segs = self.env.segs(scope, path).ok()?;
         Some(
             segs.iter()
                 .map(|s| match (s.index, &s.arg) {
@@ -104,13 +103,13 @@ impl Builder<'_> {
         )
     }
 
-    fn bad_quantity(
+    pub(super) fn bad_quantity(
         &mut self,
         scope: ScopeId,
         at: &Seg,
         what: &str,
         known: &[&str],
-    ) -> Option<Vec<(&'static str, Probe)>> {
+    ) -> Option<Vec<(String, Probe)>> {
         let hint = match did_you_mean(&at.name.name, known.iter().copied()) {
             Some(s) => format!("did you mean `{s}`? {what} provides: {}", known.join(", ")),
             None => format!("{what} provides: {}", known.join(", ")),
@@ -127,13 +126,13 @@ impl Builder<'_> {
         None
     }
 
-    fn missing_quantity(
+    pub(super) fn missing_quantity(
         &mut self,
         scope: ScopeId,
         span: Span,
         what: &str,
         known: &[&str],
-    ) -> Option<Vec<(&'static str, Probe)>> {
+    ) -> Option<Vec<(String, Probe)>> {
         self.error(
             scope,
             Diagnostic::error(
@@ -147,23 +146,23 @@ impl Builder<'_> {
     }
 
     /// Splits a vector quantity into components, or selects one.
-    fn components(
+    pub(super) fn components(
         &mut self,
         scope: ScopeId,
         rest: &[Seg],
         names: &'static [&'static str],
         make: impl Fn(usize) -> Probe,
-    ) -> Option<Vec<(&'static str, Probe)>> {
+    ) -> Option<Vec<(String, Probe)>> {
         match rest {
             [] => Some(
                 names
                     .iter()
                     .enumerate()
-                    .map(|(i, n)| (*n, make(i)))
+                    .map(|(i, n)| (format!(".{n}"), make(i)))
                     .collect(),
             ),
             [c] => match names.iter().position(|a| *a == c.name.name) {
-                Some(i) => Some(vec![("", make(i))]),
+                Some(i) => Some(vec![(String::new(), make(i))]),
                 None => self.bad_quantity(scope, c, "this quantity", names),
             },
             [_, extra, ..] => self.bad_quantity(scope, extra, "a component", &[]),
@@ -177,7 +176,7 @@ impl Builder<'_> {
         span: Span,
         what: &str,
         make: impl Fn(BodyQuantity, usize) -> Probe,
-    ) -> Option<Vec<(&'static str, Probe)>> {
+    ) -> Option<Vec<(String, Probe)>> {
         let Some(q) = rest.first() else {
             return self.missing_quantity(scope, span, what, POINT_Q);
         };
@@ -190,8 +189,9 @@ impl Builder<'_> {
         self.components(scope, &rest[1..], &AXES, |i| make(quantity, i))
     }
 
-    fn probes(&mut self, scope: ScopeId, item: &OutputItem) -> Option<Vec<(&'static str, Probe)>> {
-        let path = &item.path;
+    /// The probes a path names, each with its column suffix: `.x` for a component of a
+    /// vector, empty for a single column.
+    fn probes(&mut self, scope: ScopeId, path: &Path) -> Option<Vec<(String, Probe)>> {
         if let Some(single) = path.single() {
             let energy = match single.name.as_str() {
                 "kinetic_energy" => Some(EnergyKind::Kinetic),
@@ -200,7 +200,7 @@ impl Builder<'_> {
                 _ => None,
             };
             if let (Some(kind), None) = (energy, self.env.lookup(scope, &single.name)) {
-                return Some(vec![("", Probe::Energy { kind })]);
+                return Some(vec![(String::new(), Probe::Energy { kind })]);
             }
         }
         let segs = match self.env.segs(scope, path) {
@@ -412,7 +412,7 @@ impl Builder<'_> {
                         return self.bad_quantity(scope, extra, "a scalar joint quantity", &[]);
                     }
                     return Some(vec![(
-                        "",
+                        String::new(),
                         Probe::Joint {
                             joint: j,
                             quantity,

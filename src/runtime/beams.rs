@@ -20,7 +20,7 @@ use super::bodies::add_block;
 use super::rotation::{
     from_matrix, rotation, tangent, tangent_inverse, tangent_rate, tilde, M3, V3,
 };
-use super::{m3, Energy, Residual, State, TangentCoeffs};
+use super::{m3, Energy, MassMoments, Residual, State, TangentCoeffs};
 use serde::{Deserialize, Serialize};
 
 /// Most nodes of an element.
@@ -520,6 +520,36 @@ impl BeamElement {
             e.potential -= gp.wj * g.dot(&(self.mass * xp + meta));
         }
         e
+    }
+
+    /// Mass and first moments of mass, integrated like the inertial forces: at the inertial
+    /// quadrature points, `m x + T m eta` and its rates `m v + w x (T m eta)`,
+    /// `m a + (dw~ + w~ w~) T m eta`.
+    pub fn mass_moments(&self, st: &State) -> MassMoments {
+        let nn = self.len();
+        let x = self.positions(&st.q);
+        let t = self.triads_at(st);
+        let rel = self.relative_from(&t);
+        let (wn, dwn) = self.rates(st);
+        let mut out = MassMoments::default();
+        for gp in &self.inertial {
+            let f = self.field(&rel, &x, gp, false);
+            let (meta, _) = self.inertia(&f.t);
+            let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
+            let (mut xp, mut v) = (V3::zeros(), V3::zeros());
+            for k in 0..nn {
+                let d = &self.dofs[6 * k..6 * k + 3];
+                xp += x[k] * gp.n[k];
+                v += V3::new(st.v[d[0]], st.v[d[1]], st.v[d[2]]) * gp.n[k];
+            }
+            out += MassMoments {
+                mass: gp.wj * self.mass,
+                position: (xp * self.mass + meta) * gp.wj,
+                velocity: (v * self.mass + w.cross(&meta)) * gp.wj,
+                acceleration: (a * self.mass + dw.cross(&meta) + w.cross(&w.cross(&meta))) * gp.wj,
+            };
+        }
+        out
     }
 
     /// Mass of the element.

@@ -7,7 +7,7 @@
 //! `F_u = m a + (dw~ + w~ w~) m eta`, `F_theta = m eta~ a + J dw + w~ J w`.
 
 use super::rotation::{tilde, M3, V3};
-use super::{m3, Energy, Residual, State, TangentCoeffs};
+use super::{m3, Energy, MassMoments, Residual, State, TangentCoeffs};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -36,6 +36,16 @@ impl PointMass {
     pub fn momentum(&self, st: &State, p: &mut [f64]) {
         for &d in &self.dofs {
             p[d] += self.mass * st.v[d];
+        }
+    }
+
+    pub fn mass_moments(&self, st: &State) -> MassMoments {
+        let at = |v: &[f64]| V3::from(self.dofs.map(|i| v[i])) * self.mass;
+        MassMoments {
+            mass: self.mass,
+            position: at(&st.q),
+            velocity: at(&st.v),
+            acceleration: at(&st.a),
         }
     }
 
@@ -157,6 +167,19 @@ impl RigidBody {
             p[self.dofs[i]] += pu[i];
             p[self.dofs[3 + i]] += pt[i];
             g[self.dofs[3 + i]] += gt[i];
+        }
+    }
+
+    /// The mass centre `x + R eta0` moves with `v + w x R eta0` and accelerates with
+    /// `a + (dw~ + w~ w~) R eta0`: `m` times these (the last is `F_u` of the residual).
+    pub fn mass_moments(&self, st: &State) -> MassMoments {
+        let k = self.kin(st);
+        let at = |v: &[f64]| V3::new(v[self.dofs[0]], v[self.dofs[1]], v[self.dofs[2]]);
+        MassMoments {
+            mass: self.mass,
+            position: at(&st.q) * self.mass + k.meta,
+            velocity: at(&st.v) * self.mass + k.w.cross(&k.meta),
+            acceleration: k.a * self.mass + k.dw.cross(&k.meta) + k.w.cross(&k.w.cross(&k.meta)),
         }
     }
 

@@ -6,7 +6,7 @@ use super::beams::BeamElement;
 use super::bodies::{PointMass, RigidBody};
 use super::forces::{Load, Spring};
 use super::joints::Joint;
-use super::{Augment, Energy, Rate, Residual, State, TangentCoeffs};
+use super::{Augment, Energy, MassMoments, Rate, Residual, State, TangentCoeffs};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -89,6 +89,17 @@ impl Element {
         match self {
             Element::Beam(b) => Some(b.stiffness_scale()),
             _ => None,
+        }
+    }
+
+    /// Mass and first moments of mass (see [`MassMoments`]); `None` for elements without
+    /// mass.
+    pub fn mass_moments(&self, st: &State) -> Option<MassMoments> {
+        match self {
+            Element::PointMass(p) => Some(p.mass_moments(st)),
+            Element::RigidBody(b) => Some(b.mass_moments(st)),
+            Element::Beam(b) => Some(b.mass_moments(st)),
+            Element::Joint(_) | Element::Spring(_) | Element::Load(_) => None,
         }
     }
 

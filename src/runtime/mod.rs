@@ -26,7 +26,7 @@ pub use bodies::{PointMass, RigidBody};
 pub use elements::Element;
 pub use forces::{Load, LoadKind, Spring, SpringKind};
 pub use joints::{End, EndKin, Joint, Row};
-pub use probes::{EnergyKind, Probe, ProbeQuantity};
+pub use probes::{Coleman, EnergyKind, MassMoments, Probe, ProbeQuantity};
 
 use rotation::{M3, V3};
 use serde::{Deserialize, Serialize};

@@ -116,7 +116,35 @@ impl Path {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct OutputItem {
     pub name: Option<Name>,
-    pub path: Path,
+    pub target: OutputTarget,
+    pub span: Span,
+}
+
+/// What an output item measures: a path to a quantity, or an output function.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum OutputTarget {
+    /// `bob.position.x`
+    Path(Path),
+    /// `center_of_mass(rotor).x`
+    Call(OutputCall),
+}
+
+/// `FUNCTION(arg, name = arg, ...).component...`: a quantity derived from several entities.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutputCall {
+    pub function: Ident,
+    pub args: Vec<OutputArg>,
+    /// The words after the closing parenthesis: `.velocity.x`.
+    pub components: Vec<Ident>,
+    pub span: Span,
+}
+
+/// One argument of an output function: a reference, positional or named.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct OutputArg {
+    pub name: Option<Ident>,
+    pub value: Path,
     pub span: Span,
 }
 

@@ -551,15 +551,46 @@ impl Cx {
     fn output_item(&self, p: Pair<Rule>) -> Parsed<OutputItem> {
         let span = self.span(&p);
         let mut name = None;
-        let mut path = None;
+        let mut target = None;
         for q in p.into_inner() {
             match q.as_rule() {
                 Rule::name => name = Some(self.name(q)?),
-                _ => path = Some(self.path(q)?),
+                Rule::output_call => target = Some(OutputTarget::Call(self.output_call(q)?)),
+                _ => target = Some(OutputTarget::Path(self.path(q)?)),
             }
         }
-        let path = path.ok_or_else(|| internal("output path").at(span, "here"))?;
-        Ok(OutputItem { name, path, span })
+        let target = target.ok_or_else(|| internal("output path").at(span, "here"))?;
+        Ok(OutputItem { name, target, span })
+    }
+
+    fn output_call(&self, p: Pair<Rule>) -> Parsed<OutputCall> {
+        let span = self.span(&p);
+        let mut it = p.into_inner();
+        let function = self.ident(take(&mut it, "output function name")?);
+        let mut args = Vec::new();
+        for a in take(&mut it, "output function arguments")?.into_inner() {
+            let aspan = self.span(&a);
+            let mut name = None;
+            let mut value = None;
+            for q in a.into_inner() {
+                match q.as_rule() {
+                    Rule::word => name = Some(self.ident(q)),
+                    _ => value = Some(self.path(q)?),
+                }
+            }
+            args.push(OutputArg {
+                name,
+                value: value.ok_or_else(|| internal("argument").at(aspan, "here"))?,
+                span: aspan,
+            });
+        }
+        let components = it.map(|w| self.ident(w)).collect();
+        Ok(OutputCall {
+            function,
+            args,
+            components,
+            span,
+        })
     }
 
     fn expr(&self, p: Pair<Rule>) -> Parsed<Expr> {

@@ -405,3 +405,76 @@ fn beam_tangents_match_central_differences() {
         assert!(worst < 1e-6);
     }
 }
+
+/// The centre-of-mass probe weighs each element as its inertia does: at random states the
+/// first moment of mass times gravity is the gravity potential, its velocity moment is the
+/// translational momentum, and its acceleration moment the translational inertial force.
+#[test]
+fn mass_moments_agree_with_momentum_inertia_and_gravity() {
+    let mut rng = Lcg(23);
+    let mut cases: Vec<(Element, State)> = Vec::new();
+    for case in 0..6 {
+        let st = random_state(&mut rng);
+        let body = elements(&mut rng, case).swap_remove(0);
+        cases.push((body, st.clone()));
+        cases.push((
+            Element::PointMass(PointMass {
+                dofs: [0, 1, 2],
+                mass: 1.0 + rng.next().abs(),
+                gravity: rng.v3(),
+            }),
+            st,
+        ));
+        let (beam, st) = beam_case(&mut rng, 2 + case % 3);
+        cases.push((Element::Beam(beam), st));
+    }
+    for (i, (el, st)) in cases.iter().enumerate() {
+        let m = el.mass_moments(st).expect("an element with mass");
+        let n = st.q.len();
+        let translations: Vec<usize> = el
+            .indices()
+            .chunks(if matches!(el, Element::PointMass(_)) {
+                3
+            } else {
+                6
+            })
+            .flat_map(|c| c[..3].to_vec())
+            .collect();
+        let sum = |v: &[f64]| -> V3 {
+            let mut s = V3::zeros();
+            for (k, &d) in translations.iter().enumerate() {
+                s[k % 3] += v[d];
+            }
+            s
+        };
+        let (mut p, mut g) = (vec![0.0; n], vec![0.0; n]);
+        el.momentum(st, &mut p, &mut g);
+        let mut r = Residual::new(n);
+        let aug = Augment {
+            s: 1.0,
+            p: 1.0,
+            rate_scale: 1.0,
+        };
+        el.residual(st, aug, &mut r);
+        let gravity = V3::new(0.3, -1.1, 0.7);
+        let potential = |g: V3| {
+            let mut e = el.clone();
+            match &mut e {
+                Element::PointMass(x) => x.gravity = g.into(),
+                Element::RigidBody(x) => x.gravity = g.into(),
+                Element::Beam(x) => x.gravity = g.into(),
+                _ => unreachable!(),
+            }
+            e.energy(st).potential
+        };
+        let close = |a: V3, b: V3| (a - b).norm() < 1e-12 * (1.0 + b.norm());
+        assert!(close(m.velocity, sum(&p)), "case {i}: velocity moment");
+        assert!(close(m.acceleration, sum(&r.inertia)), "case {i}: inertia");
+        let work = potential(V3::zeros()) - potential(gravity);
+        assert!(
+            (work - gravity.dot(&m.position)).abs() < 1e-12 * (1.0 + work.abs()),
+            "case {i}: position moment"
+        );
+        assert!(m.mass > 0.0);
+    }
+}
