@@ -16,8 +16,8 @@ macro_rules! out_line {
     }};
 }
 
-mod study_cmd;
 mod stability_cmd;
+mod study_cmd;
 
 #[derive(Parser)]
 #[command(

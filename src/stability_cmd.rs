@@ -64,7 +64,7 @@ pub struct StabilityArgs {
     #[arg(long, default_value_t = 300)]
     samples: usize,
     /// Unstable when the largest real part exceeds this (1/s).
-    #[arg(long, default_value_t = 1e-3, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = 1e-2, allow_negative_numbers = true)]
     threshold: f64,
     /// Bisections of each edge of an unstable range.
     #[arg(long, default_value_t = 6)]
@@ -125,7 +125,9 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
     }
     if let Some(t) = a.period {
         if !(t.is_finite() && t > 0.0) {
-            return usage(&format!("--period must be a positive time in seconds, got {t}"));
+            return usage(&format!(
+                "--period must be a positive time in seconds, got {t}"
+            ));
         }
     }
     if !a.threshold.is_finite() {
@@ -138,9 +140,7 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
                 Some((f.trim().parse::<f64>().ok()?, t.trim().parse::<f64>().ok()?))
             });
             match parsed {
-                Some((f, t)) if f.is_finite() && t.is_finite() && f >= 0.0 && t > f => {
-                    Some((f, t))
-                }
+                Some((f, t)) if f.is_finite() && t.is_finite() && f >= 0.0 && t > f => Some((f, t)),
                 _ => {
                     return usage(&format!(
                         "--window takes FROM:TO in seconds with 0 <= FROM < TO, got `{w}`"
@@ -168,7 +168,13 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
     // The model compiles at the first value (reports its errors and warnings once).
     let mut first_sets = a.set.clone();
     first_sets.push(format!("{param}={}", values[0]));
-    let c = match compile(&a.model, &text, &first_sets, Overrides::default(), Format::Human) {
+    let c = match compile(
+        &a.model,
+        &text,
+        &first_sets,
+        Overrides::default(),
+        Format::Human,
+    ) {
         Ok(c) => c,
         Err(code) => return code,
     };
@@ -238,15 +244,13 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
     let compile_job = |extra: &[String]| {
         let mut all = sets.to_vec();
         all.extend_from_slice(extra);
-        mbd::compile_with(path, &text, &all, Overrides::default(), &FsLoader::new()).map_err(
-            |f| {
-                f.diagnostics
-                    .iter()
-                    .find(|d| d.is_error())
-                    .map(|d| format!("{} {}", d.code.as_str(), d.message))
-                    .unwrap_or_else(|| "the model does not compile".to_string())
-            },
-        )
+        mbd::compile_with(path, &text, &all, Overrides::default(), &FsLoader::new()).map_err(|f| {
+            f.diagnostics
+                .iter()
+                .find(|d| d.is_error())
+                .map(|d| format!("{} {}", d.code.as_str(), d.message))
+                .unwrap_or_else(|| "the model does not compile".to_string())
+        })
     };
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = indicatif::ProgressBar::new(0);
@@ -293,10 +297,8 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
 
 /// The columns of a reference CSV as lines against its first column.
 fn reference_series(path: &str) -> Result<Vec<Series>, String> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| format!("cannot read `{path}`: {e}"))?;
-    let (header, rows) =
-        mbd::output::read_csv(&text).map_err(|e| format!("`{path}`: {e}"))?;
+    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read `{path}`: {e}"))?;
+    let (header, rows) = mbd::output::read_csv(&text).map_err(|e| format!("`{path}`: {e}"))?;
     if header.len() < 2 {
         return Err(format!(
             "`{path}` needs the param in its first column and at least one more column"
@@ -366,6 +368,11 @@ fn print_report(s: &sweep::Sweep) {
         ));
     }
     for (a, b) in ranges {
-        say(&format!("unstable: {} < {} < {}", short(a), s.param, short(b)));
+        say(&format!(
+            "unstable: {} < {} < {}",
+            short(a),
+            s.param,
+            short(b)
+        ));
     }
 }

@@ -71,7 +71,7 @@ impl Builder<'_> {
                     continue;
                 }
             };
-            if let Some(dim) = self.channel_dim(&column.probe) {
+            if let Some(dim) = channel_dim(&self.joints, &column.probe) {
                 if v.dim() != dim {
                     let d = Diagnostic::error(
                         Code::E0202,
@@ -155,40 +155,40 @@ impl Builder<'_> {
         );
         None
     }
+}
 
-    /// The physical dimension of what a probe measures (`None` where it varies by row, as for
-    /// a joint's constraint violation).
-    fn channel_dim(&self, probe: &Probe) -> Option<Dim> {
-        let body = |q: BodyQuantity| match q {
-            BodyQuantity::Position => Dim::LENGTH,
-            BodyQuantity::Velocity => Dim::VELOCITY,
-            BodyQuantity::Acceleration => Dim::ACCELERATION,
-            BodyQuantity::AngularVelocity => Dim::NONE.over(Dim::TIME),
-            BodyQuantity::AngularAcceleration => Dim::NONE.over(Dim::TIME).over(Dim::TIME),
-            BodyQuantity::Rotation | BodyQuantity::Crv => Dim::NONE,
-        };
-        match probe {
-            Probe::Body { quantity, .. } | Probe::Point { quantity, .. } => Some(body(*quantity)),
-            Probe::Energy { .. } => Some(Dim::FORCE.times(Dim::LENGTH)),
-            Probe::CenterOfMass { quantity, .. } => Some(body(*quantity)),
-            // Angles are dimensionless, and so are their multiblade coordinates.
-            Probe::Multiblade { .. } => Some(Dim::NONE),
-            Probe::Joint {
-                joint, quantity, ..
-            } => {
-                let prismatic = matches!(
-                    self.joints.get(*joint).map(|j| &j.kind),
-                    Some(JointKind::Prismatic { .. })
-                );
-                match (quantity, prismatic) {
-                    (JointQuantity::Force, _) => Some(Dim::FORCE),
-                    (JointQuantity::Moment, _) => Some(Dim::FORCE.times(Dim::LENGTH)),
-                    (JointQuantity::Angle, false) => Some(Dim::NONE),
-                    (JointQuantity::Angle, true) => Some(Dim::LENGTH),
-                    (JointQuantity::Rate, false) => Some(Dim::NONE.over(Dim::TIME)),
-                    (JointQuantity::Rate, true) => Some(Dim::VELOCITY),
-                    (JointQuantity::Violation, _) => None,
-                }
+/// The physical dimension of what a probe measures (`None` where it varies by row, as for
+/// a joint's constraint violation).
+pub fn channel_dim(joints: &[Joint], probe: &Probe) -> Option<Dim> {
+    let body = |q: BodyQuantity| match q {
+        BodyQuantity::Position => Dim::LENGTH,
+        BodyQuantity::Velocity => Dim::VELOCITY,
+        BodyQuantity::Acceleration => Dim::ACCELERATION,
+        BodyQuantity::AngularVelocity => Dim::NONE.over(Dim::TIME),
+        BodyQuantity::AngularAcceleration => Dim::NONE.over(Dim::TIME).over(Dim::TIME),
+        BodyQuantity::Rotation | BodyQuantity::Crv => Dim::NONE,
+    };
+    match probe {
+        Probe::Body { quantity, .. } | Probe::Point { quantity, .. } => Some(body(*quantity)),
+        Probe::Energy { .. } => Some(Dim::FORCE.times(Dim::LENGTH)),
+        Probe::CenterOfMass { quantity, .. } => Some(body(*quantity)),
+        // Angles are dimensionless, and so are their multiblade coordinates.
+        Probe::Multiblade { .. } => Some(Dim::NONE),
+        Probe::Joint {
+            joint, quantity, ..
+        } => {
+            let prismatic = matches!(
+                joints.get(*joint).map(|j| &j.kind),
+                Some(JointKind::Prismatic { .. })
+            );
+            match (quantity, prismatic) {
+                (JointQuantity::Force, _) => Some(Dim::FORCE),
+                (JointQuantity::Moment, _) => Some(Dim::FORCE.times(Dim::LENGTH)),
+                (JointQuantity::Angle, false) => Some(Dim::NONE),
+                (JointQuantity::Angle, true) => Some(Dim::LENGTH),
+                (JointQuantity::Rate, false) => Some(Dim::NONE.over(Dim::TIME)),
+                (JointQuantity::Rate, true) => Some(Dim::VELOCITY),
+                (JointQuantity::Violation, _) => None,
             }
         }
     }

@@ -14,6 +14,7 @@ mod elaborate;
 mod env;
 pub mod eval;
 mod exact;
+pub use exact::channel_dim;
 mod output_calls;
 mod outputs;
 mod settings;

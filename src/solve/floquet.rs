@@ -142,7 +142,11 @@ fn perturbed(
 ) -> State {
     let nfree = free.len();
     let r = basis.len() / nfree;
-    let (col, velocity) = if dir < r { (dir, false) } else { (dir - r, true) };
+    let (col, velocity) = if dir < r {
+        (dir, false)
+    } else {
+        (dir - r, true)
+    };
     let col = &basis[col * nfree..(col + 1) * nfree];
     let mut st = sys.initial.clone();
     let mut turns = vec![V3::zeros(); sys.rotations.len()];
@@ -237,7 +241,15 @@ pub fn floquet(
             };
             let start = perturbed(sys, &free, &basis, &weights, omega, dir, sign * EPSILON);
             it.restart(&start).map_err(fail)?;
-            let a = measure(sys, it.state(), &start_reference, &free, &basis, &weights, omega);
+            let a = measure(
+                sys,
+                it.state(),
+                &start_reference,
+                &free,
+                &basis,
+                &weights,
+                omega,
+            );
             let end = integrate(&mut it, steps, h).map_err(fail)?;
             newton_iterations += it.stats().newton_iterations;
             let b = measure(sys, &end, &reference, &free, &basis, &weights, omega);
@@ -256,7 +268,8 @@ pub fn floquet(
                 t: 0.0,
                 step: 0,
                 entity: None,
-                detail: "the perturbed starts are not independent once projected onto the joints".into(),
+                detail: "the perturbed starts are not independent once projected onto the joints"
+                    .into(),
             }))
         }
     };

@@ -1,10 +1,12 @@
 //! Damping from a transient: the matrix pencil method (THEORY §9.3), several signals sharing
 //! their poles.
 //!
-//! Each signal is scaled by its largest magnitude; their Hankel matrices (`K - L` rows of
+//! Signals are scaled by the largest magnitude of their group (signals of one physical
+//! dimension); their Hankel matrices (`K - L` rows of
 //! `L + 1` samples, pencil parameter `L = K / 3`) are stacked and decomposed (SVD). The model
 //! order `M` is the number of singular values above `rank_tolerance` of the largest (at most
-//! `max_order`); with `V'` the `M` leading right singular vectors, `V1` and `V2` it without its
+//! `max_order`), cut at the last drop by more than `gap` between neighbours (the noise floor
+//! of the integration, when the signals show one); with `V'` the `M` leading right singular vectors, `V1` and `V2` it without its
 //! last and first row, the poles `z` are the eigenvalues of `V1^+ V2`, and
 //! `s = ln z / dt`. Each pole's amplitude in each signal comes from a least-squares fit of the
 //! signal by the poles' real modes (`Re z^k`, `Im z^k`); a pole is kept if its largest
@@ -22,8 +24,14 @@ pub struct PencilSpec {
     pub max_order: usize,
     /// Singular values below this fraction of the largest are noise.
     pub rank_tolerance: f64,
+    /// A drop by more than this factor between neighbouring singular values marks the noise
+    /// floor: the order stops there.
+    pub gap: f64,
     /// Poles contributing less than this fraction of every signal's peak are dropped.
     pub amplitude_tolerance: f64,
+    /// Signals whose peak is below this fraction of their group's largest peak are not
+    /// excited (numerical noise), and are skipped.
+    pub unexcited: f64,
 }
 
 impl Default for PencilSpec {
@@ -31,7 +39,9 @@ impl Default for PencilSpec {
         PencilSpec {
             max_order: 40,
             rank_tolerance: 1e-7,
-            amplitude_tolerance: 1e-3,
+            gap: 100.0,
+            amplitude_tolerance: 1e-2,
+            unexcited: 1e-6,
         }
     }
 }
@@ -56,14 +66,53 @@ fn solve_ls(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Option<DMatrix<f64>> {
     Some(DMatrix::from_row_slice(cols, nrhs, &x))
 }
 
-/// The poles of uniformly sampled signals (step `dt`), largest amplitude first.
-pub fn matrix_pencil(signals: &[Vec<f64>], dt: f64, spec: &PencilSpec) -> Result<Vec<Pole>, String> {
-    let scaled: Vec<Vec<f64>> = signals
+/// The pencil's eigenvalues `z` at order `m`, from the right singular vectors `vs` (columns
+/// of length `width`, leading first): `V1 A = V2` in least squares.
+fn pencil_poles(vs: &[f64], width: usize, m: usize) -> Result<Vec<c64>, String> {
+    let l = width - 1;
+    let v = DMatrix::<f64>::from_fn(width, m, |i, j| vs[j * width + i]);
+    let v1 = v.rows(0, l).into_owned();
+    let v2 = v.rows(1, l).into_owned();
+    let a = solve_ls(&v1, &v2).ok_or("the pencil could not be formed")?;
+    let col: Vec<f64> = (0..m * m).map(|p| a[(p % m, p / m)]).collect();
+    let identity: Vec<f64> = (0..m * m)
+        .map(|p| if p % (m + 1) == 0 { 1.0 } else { 0.0 })
+        .collect();
+    let eig = generalized_eigen(&col, &identity, m).ok_or("the pencil's eigenvalues failed")?;
+    Ok(eig
         .iter()
-        .filter_map(|y| {
-            let peak = y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-            (peak > 0.0 && peak.is_finite() && y.iter().all(|x| x.is_finite()))
-                .then(|| y.iter().map(|x| x / peak).collect())
+        .map(|((ar, ai), (br, bi), _)| {
+            let d = br * br + bi * bi;
+            c64::new((ar * br + ai * bi) / d, (ai * br - ar * bi) / d)
+        })
+        .filter(|z| z.re.is_finite() && z.im.is_finite() && (z.re != 0.0 || z.im != 0.0))
+        .collect())
+}
+
+/// The poles of uniformly sampled signals (step `dt`), largest amplitude first. Signals of the
+/// same group (the same physical dimension) share one scale, the group's largest peak, so a
+/// weakly excited signal weighs little; without groups each signal is its own.
+pub fn matrix_pencil(
+    signals: &[Vec<f64>],
+    groups: Option<&[usize]>,
+    dt: f64,
+    spec: &PencilSpec,
+) -> Result<Vec<Pole>, String> {
+    let peak_of = |y: &Vec<f64>| y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let group = |i: usize| groups.map_or(i, |g| g[i]);
+    let finite = |y: &Vec<f64>| y.iter().all(|x| x.is_finite());
+    // Each group's scale: the largest peak of its signals.
+    let scale = |i: usize| {
+        (0..signals.len())
+            .filter(|&j| group(j) == group(i) && finite(&signals[j]))
+            .map(|j| peak_of(&signals[j]))
+            .fold(0.0f64, f64::max)
+    };
+    let scaled: Vec<Vec<f64>> = (0..signals.len())
+        .filter_map(|i| {
+            let (y, s) = (&signals[i], scale(i));
+            (finite(y) && peak_of(y) > spec.unexcited * s && s > 0.0)
+                .then(|| y.iter().map(|x| x / s).collect())
         })
         .collect();
     let k = scaled.iter().map(Vec::len).min().unwrap_or(0);
@@ -90,34 +139,43 @@ pub fn matrix_pencil(signals: &[Vec<f64>], dt: f64, spec: &PencilSpec) -> Result
     if !(smax > 0.0) {
         return Err("the signals carry no energy".into());
     }
-    let m = sv
+    // The model order: singular values above the tolerance, cut at the last gap of more than
+    // `gap` between neighbours (the noise floor of the integration) if there is one.
+    let above = sv
         .iter()
         .take_while(|&&x| x > spec.rank_tolerance * smax)
         .count()
         .min(spec.max_order)
         .min(l);
+    let m = (1..above.min(sv.len() - 1) + 1)
+        .rev()
+        .find(|&k| sv[k] * spec.gap < sv[k - 1])
+        .unwrap_or(above);
     if m == 0 {
         return Ok(Vec::new());
     }
-    // V' ((L + 1) x M): the leading right singular vectors as columns; V1 A = V2 in least
-    // squares.
-    let v = DMatrix::<f64>::from_fn(width, m, |i, j| vs[j * width + i]);
-    let v1 = v.rows(0, l).into_owned();
-    let v2 = v.rows(1, l).into_owned();
-    let a = solve_ls(&v1, &v2).ok_or("the pencil could not be formed")?;
-    let col: Vec<f64> = (0..m * m).map(|p| a[(p % m, p / m)]).collect();
-    let identity: Vec<f64> = (0..m * m)
-        .map(|p| if p % (m + 1) == 0 { 1.0 } else { 0.0 })
-        .collect();
-    let eig = generalized_eigen(&col, &identity, m).ok_or("the pencil's eigenvalues failed")?;
-    // Poles z, one per conjugate pair (Im z >= 0).
-    let zs: Vec<c64> = eig
+    let zs = pencil_poles(&vs, width, m)?;
+    // Stabilization: a pole of the data stays put when the order grows by 2, 4 and 6; poles
+    // fitted to the noise move. Keep the poles of order M found again at the larger orders
+    // (within 1e-3 of |ln z|, i.e. of |s| dt), when the data allow them.
+    let extra: Vec<Vec<c64>> = [m + 2, m + 4, m + 6]
         .iter()
-        .map(|((ar, ai), (br, bi), _)| {
-            let d = br * br + bi * bi;
-            c64::new((ar * br + ai * bi) / d, (ai * br - ar * bi) / d)
+        .filter(|&&o| o <= l && o <= sv.len())
+        .map(|&o| pencil_poles(&vs, width, o))
+        .collect::<Result<_, _>>()?;
+    let log_of = |z: &c64| c64::new((z.re * z.re + z.im * z.im).sqrt().ln(), z.im.atan2(z.re));
+    let zs: Vec<c64> = zs
+        .into_iter()
+        .filter(|z| {
+            let a = log_of(z);
+            extra.iter().all(|set| {
+                set.iter().any(|w| {
+                    let b = log_of(w);
+                    (a.re - b.re).abs() + (a.im - b.im).abs()
+                        <= 1e-3 * (a.re * a.re + a.im * a.im).sqrt().max(1e-3)
+                })
+            })
         })
-        .filter(|z| z.re.is_finite() && z.im.is_finite() && (z.re != 0.0 || z.im != 0.0))
         .collect();
     let tiny = 1e-9;
     let mut poles: Vec<c64> = Vec::new();
@@ -206,6 +264,7 @@ mod tests {
         };
         let poles = matrix_pencil(
             &[signal([1.0, 1e-2, 0.5]), signal([0.0, 2.0, 0.1])],
+            None,
             dt,
             &PencilSpec::default(),
         )
@@ -222,7 +281,7 @@ mod tests {
 
     #[test]
     fn too_short_or_empty_signals_are_errors() {
-        assert!(matrix_pencil(&[vec![1.0; 5]], 0.1, &PencilSpec::default()).is_err());
-        assert!(matrix_pencil(&[vec![0.0; 100]], 0.1, &PencilSpec::default()).is_err());
+        assert!(matrix_pencil(&[vec![1.0; 5]], None, 0.1, &PencilSpec::default()).is_err());
+        assert!(matrix_pencil(&[vec![0.0; 100]], None, 0.1, &PencilSpec::default()).is_err());
     }
 }

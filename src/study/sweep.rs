@@ -12,7 +12,7 @@
 
 use super::prony::{matrix_pencil, PencilSpec};
 use super::{cell, parallel, thread_cpu_seconds};
-use crate::model::{Drive, JointKind};
+use crate::model::{channel_dim, Drive, JointKind, Probe};
 use crate::output::charts::{Chart, Series};
 use crate::solve::floquet;
 use crate::solve::modes::c64;
@@ -46,7 +46,7 @@ pub struct SweepSpec {
     pub methods: Vec<Method>,
     /// Floquet's period (s); `None`: `2 pi / Omega` of the model's prescribed rotor speed.
     pub period: Option<f64>,
-    /// Prony: the channels fitted (empty: every output channel).
+    /// Prony: the channels fitted (empty: [`default_signals`]).
     pub signals: Vec<String>,
     /// Prony: the part of the run fitted (s); `None`: from a tenth of the run to its end.
     pub window: Option<(f64, f64)>,
@@ -298,15 +298,22 @@ fn prony_point(spec: &SweepSpec, mut c: Compiled) -> Result<(Vec<c64>, String), 
     let mut out = Vec::new();
     let run = crate::run(&c, &mut out);
     if let Err(f) = &run {
-        return Err(format!("{} {}", f.diagnostic.code.as_str(), f.diagnostic.message));
+        return Err(format!(
+            "{} {}",
+            f.diagnostic.code.as_str(),
+            f.diagnostic.message
+        ));
     }
     let text = String::from_utf8(out).map_err(|e| e.to_string())?;
     let (header, rows) = crate::output::read_csv(&text)?;
-    let columns: Vec<usize> = if spec.signals.is_empty() {
-        (0..header.len()).filter(|&k| header[k] != "t").collect()
+    let wanted = if spec.signals.is_empty() {
+        default_signals(&c)
     } else {
+        spec.signals.clone()
+    };
+    let columns: Vec<usize> = {
         let mut v = Vec::new();
-        for s in &spec.signals {
+        for s in &wanted {
             match header.iter().position(|h| h == s) {
                 Some(k) => v.push(k),
                 None => return Err(format!("the model has no output channel `{s}`")),
@@ -323,7 +330,25 @@ fn prony_point(spec: &SweepSpec, mut c: Compiled) -> Result<(Vec<c64>, String), 
         .map(|&k| kept.iter().map(|r| r[k]).collect())
         .collect();
     let step = dt * every as f64;
-    let poles = matrix_pencil(&signals, step, &PencilSpec::default())?;
+    // Signals of one physical dimension share a scale.
+    let dims: Vec<Option<crate::model::units::Dim>> = wanted
+        .iter()
+        .map(|w| {
+            c.model
+                .outputs
+                .iter()
+                .find(|o| &o.column == w)
+                .and_then(|o| channel_dim(&c.model.joints, &o.probe))
+        })
+        .collect();
+    let groups: Vec<usize> = (0..dims.len())
+        .map(|i| {
+            dims.iter()
+                .position(|d| d.is_some() && *d == dims[i])
+                .unwrap_or(i)
+        })
+        .collect();
+    let poles = matrix_pencil(&signals, Some(&groups), step, &PencilSpec::default())?;
     let mut modes: Vec<c64> = poles.iter().map(|p| p.s).collect();
     modes.sort_by(|a, b| b.re.total_cmp(&a.re));
     Ok((
@@ -336,6 +361,24 @@ fn prony_point(spec: &SweepSpec, mut c: Compiled) -> Result<(Vec<c64>, String), 
             step
         ),
     ))
+}
+
+/// Prony's default signals: every output channel but the blade coordinates that a
+/// `multiblade` output transforms (rotating-frame signals carry the rotor's harmonics; their
+/// multiblade coordinates are the fixed-frame signals of THEORY §9.3).
+pub fn default_signals(c: &Compiled) -> Vec<String> {
+    let mut blades: Vec<usize> = Vec::new();
+    for o in &c.model.outputs {
+        if let Probe::Multiblade { blades: b, .. } = &o.probe {
+            blades.extend(b);
+        }
+    }
+    c.model
+        .outputs
+        .iter()
+        .filter(|o| !matches!(&o.probe, Probe::Joint { joint, .. } if blades.contains(joint)))
+        .map(|o| o.column.clone())
+        .collect()
 }
 
 /// Runs the sweep: the grid in parallel, then each edge's bisection (edges in parallel).
@@ -468,14 +511,15 @@ impl Sweep {
         let (Some(first), Some(last)) = (grid.first(), grid.last()) else {
             return Vec::new();
         };
-        let (lo, hi) = (
-            first.value.min(last.value),
-            first.value.max(last.value),
-        );
+        let (lo, hi) = (first.value.min(last.value), first.value.max(last.value));
         let mut out = Vec::new();
         let mut open: Option<f64> = None;
         let starts_unstable = {
-            let low = if first.value <= last.value { first } else { last };
+            let low = if first.value <= last.value {
+                first
+            } else {
+                last
+            };
             low.max_real() > self.threshold
         };
         if starts_unstable {
