@@ -108,7 +108,7 @@ pub fn render(chart: &Chart) -> Result<String, String> {
                 let shade = RGBColor(214, 39, 40).mix(0.12);
                 for (k, &(a, b)) in chart.shaded.iter().enumerate() {
                     let (a, b) = (a.max(x0), b.min(x1));
-                    if !(b > a) {
+                    if b.partial_cmp(&a) != Some(std::cmp::Ordering::Greater) {
                         continue;
                     }
                     let area = c

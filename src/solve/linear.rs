@@ -173,7 +173,7 @@ pub fn least_squares(
     let smax = (0..k).map(|i| s[i].abs()).fold(0.0, f64::max);
     let mut x = vec![0.0; cols * nrhs];
     for i in 0..k {
-        if !(s[i].abs() > cutoff * smax) {
+        if s[i].abs() <= cutoff * smax || s[i].is_nan() {
             continue;
         }
         for r in 0..nrhs {

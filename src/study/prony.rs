@@ -136,7 +136,7 @@ pub fn matrix_pencil(
         .ok_or("the singular value decomposition failed")?;
     let smax = sv.first().copied().unwrap_or(0.0);
 
-    if !(smax > 0.0) {
+    if smax.is_nan() || smax <= 0.0 {
         return Err("the signals carry no energy".into());
     }
     // The model order: singular values above the tolerance, cut at the last gap of more than

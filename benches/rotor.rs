@@ -1,0 +1,57 @@
+//! Benchmarks of the rotor analyses on the windmill (P5): the paper's 3 s run (6,000 steps of
+//! HHT -0.1), and one point of a stability sweep by each method at Omega_bar = 1.5 (Floquet:
+//! 21 runs of one period, 1,396 steps each; Prony: the 3 s run and the matrix-pencil fit). A
+//! 50-point sweep costs about 50 Floquet points over the cores; its wall time is measured by
+//! `mbd stability` itself (see the closing note of issue 7).
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use mbd::model::Overrides;
+use mbd::study::sweep::{self, Method, SweepSpec};
+
+fn text() -> String {
+    std::fs::read_to_string(format!(
+        "{}/models/windmill.mbd",
+        env!("CARGO_MANIFEST_DIR")
+    ))
+    .unwrap_or_default()
+}
+
+fn runs(c: &mut Criterion) {
+    let source = text();
+    if let Ok(compiled) = mbd::compile("windmill.mbd", &source, &[], Overrides::default()) {
+        let mut out = Vec::with_capacity(1 << 22);
+        c.bench_function("windmill: 3 s run, 6000 steps", |b| {
+            b.iter(|| {
+                out.clear();
+                mbd::run(&compiled, &mut out).is_ok()
+            })
+        });
+    }
+    for method in [Method::Floquet, Method::Prony] {
+        let spec = SweepSpec {
+            param: "Omega_bar".to_string(),
+            values: vec![1.5],
+            methods: vec![method],
+            period: None,
+            signals: Vec::new(),
+            window: None,
+            samples: 300,
+            threshold: 1e-2,
+            refine: 0,
+        };
+        let compile = |extra: &[String]| {
+            mbd::compile("windmill.mbd", &source, extra, Overrides::default())
+                .map_err(|f| format!("{:?}", f.diagnostics))
+        };
+        c.bench_function(&format!("windmill: one {} point", method.name()), |b| {
+            b.iter(|| sweep::sweep(&spec, &compile, &|_| {}).points[0].max_real())
+        });
+    }
+}
+
+criterion_group! {
+    name = benches;
+    config = Criterion::default().sample_size(10);
+    targets = runs
+}
+criterion_main!(benches);
