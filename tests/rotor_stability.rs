@@ -75,6 +75,30 @@ fn floquet_finds_the_ground_resonance_band_of_the_multiblade_equations() {
     }
 }
 
+/// The band edges for 3 and 5 blades: a grid just around each multiblade edge (0.01 either
+/// side), bisected three times, brackets it within 0.0025.
+#[test]
+fn floquet_band_edges_for_3_and_5_blades_match_their_multiblade_equations() {
+    for blades in [3usize, 5] {
+        let (lo, hi) = (mbc_edge(blades, 1.0, 1.5), mbc_edge(blades, 2.0, 3.0));
+        let values = vec![lo - 0.01, lo + 0.01, hi - 0.01, hi + 0.01];
+        let s = run(&spec(values, vec![Method::Floquet], 3), blades);
+        for p in &s.points {
+            ok(p);
+        }
+        let edges: Vec<f64> = s.edges.iter().map(|e| e.value).collect();
+        println!("N = {blades}: multiblade band {lo:.5} .. {hi:.5}, mbd stability {edges:?}");
+        assert_eq!(s.edges.len(), 2, "{:?}", s.edges);
+        for (e, want) in s.edges.iter().zip([lo, hi]) {
+            assert!(
+                e.bracket.0 <= want && want <= e.bracket.1 && e.bracket.1 - e.bracket.0 < 0.0026,
+                "N = {blades}: edge {:?} vs {want}",
+                e.bracket
+            );
+        }
+    }
+}
+
 /// Growth rates of the regressing lag mode within 2 % of the multiblade eigenvalues, for 3, 4
 /// and 5 blades, by Floquet and by Prony (fixed-frame signals); the frequencies agree too
 /// (Floquet's modulo Omega).

@@ -17,7 +17,7 @@ target/release/examples/windmill_mbc 4 > "$out/p5_mbc.csv"
     | tee "$out/p5_stability.txt"
 
 for w in 1.0 2.0; do
-    "$mbd" run models/windmill.mbd --set Omega_bar=$w --every 5 -o "$out/p5_windmill_$w.csv"
+    "$mbd" run models/windmill.mbd --set Omega_bar=$w --every 10 -o "$out/p5_windmill_$w.csv"
     "$mbd" plot "$out/p5_windmill_$w.csv" --channel zeta1 --channel zeta2 --channel zeta3 \
         --channel zeta4 --title "P5 lag angles [rad], Omega_bar = $w (Figs. 19-21)" \
         -o "$out/p5_lag_$w.svg"
@@ -28,7 +28,7 @@ for w in 1.0 2.0; do
 done
 
 for t0 in 2500 500; do
-    "$mbd" run models/windmill_spinup.mbd --set T0=$t0 --every 5 -o "$out/p6_spinup_$t0.csv"
+    "$mbd" run models/windmill_spinup.mbd --set T0=$t0 --every 10 -o "$out/p6_spinup_$t0.csv"
     "$mbd" plot "$out/p6_spinup_$t0.csv" --channel Omega_hub \
         --title "P6 rotor speed [rad/s], T0 = $t0 N m (Fig. 24)" -o "$out/p6_speed_$t0.svg"
     "$mbd" plot "$out/p6_spinup_$t0.csv" --channel zeta1 --channel zeta3 --channel zeta_1c \

@@ -349,12 +349,18 @@ fn prony_point(spec: &SweepSpec, mut c: Compiled) -> Result<(Vec<c64>, String), 
         })
         .collect();
     let poles = matrix_pencil(&signals, Some(&groups), step, &PencilSpec::default())?;
+    if poles.is_empty() {
+        return Err(format!(
+            "the transient fit found no pole that holds when the model order grows ({} signals over {from:.3}..{to:.3} s): fit fixed-frame signals (--signals, e.g. multiblade coordinates; a two-bladed rotor has none), or a longer --window",
+            signals.len()
+        ));
+    }
     let mut modes: Vec<c64> = poles.iter().map(|p| p.s).collect();
     modes.sort_by(|a, b| b.re.total_cmp(&a.re));
     Ok((
         modes,
         format!(
-            "{} poles from {} signals, {} samples every {:.4e} s over {from}..{to} s",
+            "{} poles from {} signals, {} samples every {:.4e} s over {from:.3}..{to:.3} s",
             poles.len(),
             signals.len(),
             kept.len(),
