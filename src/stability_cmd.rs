@@ -23,9 +23,13 @@ principal branch, |Im s| <= pi / T.
 
 Prony (--method prony): the poles of a transient, the model's own run (its excitation \
 included), fitted by the matrix pencil method over --window (default: from a tenth of the run \
-to its end), sampled about --samples times, all output channels (or --signals) sharing the \
-poles (THEORY §9.3). Frequencies are those of the signals (rotating-frame signals show \
-the rotor's harmonics).
+to its end), sampled about --samples times, the signals sharing the poles (THEORY §9.3). The \
+signals are --signals, or by default every output channel except the blade coordinates that \
+a `multiblade` output transforms: rotating-frame signals carry the rotor's harmonics, \
+multiblade coordinates are fixed-frame. Signals of one physical dimension share a scale. The \
+model order stops at the integration's noise floor, and only poles that hold when the order \
+grows by 2, 4 and 6 and that reach 1 % of a signal's peak are kept; a fit that keeps none \
+fails (a two-bladed rotor has no fixed-frame lag coordinates: use Floquet).
 
 --method both runs both; the first listed method locates the edges. A point is unstable when \
 its largest real part exceeds --threshold. Between neighbouring values of opposite stability \
