@@ -329,6 +329,21 @@ fn compile(
     }
 }
 
+/// `println!` that does not panic when stdout is closed.
+pub(crate) fn say(text: &str) {
+    let _ = writeln!(std::io::stdout().lock(), "{text}");
+}
+
+/// Short numbers for the report: 6 significant digits, no trailing zeros.
+pub(crate) fn short(x: f64) -> String {
+    if !x.is_finite() {
+        return "-".to_string();
+    }
+    let s = format!("{x:.6e}");
+    let v: f64 = s.parse().unwrap_or(x);
+    format!("{v}")
+}
+
 fn usage(msg: &str) -> ExitCode {
     eprintln!("error: {msg}");
     ExitCode::from(EXIT_USAGE)

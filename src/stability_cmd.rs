@@ -2,7 +2,7 @@
 //! file, runs the sweep through `mbd::study::sweep` with a progress bar, writes the CSV and the
 //! chart and prints the report. The analysis itself lives in the library.
 
-use super::{compile, read, report, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
+use super::{compile, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
 use mbd::model::Overrides;
 use mbd::output::charts::Series;
 use mbd::study::sweep::{self, Method, SweepSpec, Tick};
@@ -92,19 +92,6 @@ enum MethodArg {
     Floquet,
     Prony,
     Both,
-}
-
-fn say(text: &str) {
-    let _ = writeln!(std::io::stdout().lock(), "{text}");
-}
-
-fn short(x: f64) -> String {
-    if !x.is_finite() {
-        return "-".to_string();
-    }
-    let s = format!("{x:.5e}");
-    let v: f64 = s.parse().unwrap_or(x);
-    format!("{v}")
 }
 
 pub fn stability(a: StabilityArgs) -> ExitCode {

@@ -2,7 +2,7 @@
 //! reference file, runs the study through `mbd::study`, writes its CSV and chart and prints
 //! the report. The study itself (runs, errors, orders, onsets) lives in the library.
 
-use super::{compile, read, report, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
+use super::{compile, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
 use mbd::model::Overrides;
 use mbd::study::compare::Samples;
 use mbd::study::convergence::{self, ConvergenceSpec, ReferenceSpec};
@@ -83,21 +83,6 @@ pub struct StudyArgs {
     /// Write the chart here (SVG).
     #[arg(long, value_name = "STUDY.svg")]
     chart: Option<String>,
-}
-
-/// `println!` that does not panic when stdout is closed.
-fn say(text: &str) {
-    let _ = writeln!(std::io::stdout().lock(), "{text}");
-}
-
-/// Short numbers for the report: 6 significant digits, no trailing zeros.
-fn short(x: f64) -> String {
-    if !x.is_finite() {
-        return "-".to_string();
-    }
-    let s = format!("{x:.6e}");
-    let v: f64 = s.parse().unwrap_or(x);
-    format!("{v}")
 }
 
 pub fn study(a: StudyArgs) -> ExitCode {

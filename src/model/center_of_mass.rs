@@ -79,15 +79,7 @@ impl Builder<'_> {
     /// The bodies and beams an argument of `center_of_mass` names.
     fn massive(&mut self, scope: ScopeId, a: &OutputArg) -> Option<(Vec<usize>, Vec<usize>)> {
         let path = &a.value;
-        let text = self.written(scope, path).unwrap_or_else(|| path.text());
-        let segs = match self.env.segs(scope, path) {
-            Ok(s) => s,
-            Err(d) => return self.fail(scope, d),
-        };
-        let (r, rest) = match self.env.resolve_family(scope, &segs, path.span) {
-            Ok(x) => x,
-            Err(d) => return self.fail(scope, d),
-        };
+        let (text, r, rest) = self.resolve_arg(scope, a)?;
         let not_massive = |what: String| {
             Diagnostic::error(
                 Code::E0228,

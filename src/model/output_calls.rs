@@ -242,15 +242,7 @@ impl Builder<'_> {
     /// with consecutive indices, optionally followed by `.angle`.
     fn blade_family(&mut self, scope: ScopeId, a: &OutputArg) -> Option<Vec<usize>> {
         let path = &a.value;
-        let mut text = self.written(scope, path).unwrap_or_else(|| path.text());
-        let segs = match self.env.segs(scope, path) {
-            Ok(s) => s,
-            Err(d) => return self.fail(scope, d),
-        };
-        let (r, rest) = match self.env.resolve_family(scope, &segs, path.span) {
-            Ok(x) => x,
-            Err(d) => return self.fail(scope, d),
-        };
+        let (mut text, r, rest) = self.resolve_arg(scope, a)?;
         let bad = |msg: String, label: &str, hint: String| {
             Diagnostic::error(Code::E0226, msg)
                 .at(path.span, label.to_string())
@@ -368,15 +360,7 @@ impl Builder<'_> {
     /// The joint of `multiblade`'s `azimuth`: a revolute joint, optionally with `.angle`.
     fn azimuth_joint(&mut self, scope: ScopeId, a: &OutputArg) -> Option<usize> {
         let path = &a.value;
-        let text = self.written(scope, path).unwrap_or_else(|| path.text());
-        let segs = match self.env.segs(scope, path) {
-            Ok(s) => s,
-            Err(d) => return self.fail(scope, d),
-        };
-        let (r, rest) = match self.env.resolve_family(scope, &segs, path.span) {
-            Ok(x) => x,
-            Err(d) => return self.fail(scope, d),
-        };
+        let (text, r, rest) = self.resolve_arg(scope, a)?;
         let other = match rest.as_slice() {
             [] => None,
             [q] if q.name.name == "angle" && q.index.is_none() && q.arg.is_none() => None,
@@ -426,6 +410,25 @@ impl Builder<'_> {
     }
 
     /// Reports `d` and gives up on this output.
+    /// An argument's path as written (indices evaluated) and what it resolves to; a family
+    /// named without an index stays whole.
+    pub(super) fn resolve_arg(
+        &mut self,
+        scope: ScopeId,
+        a: &OutputArg,
+    ) -> Option<(String, Ref, Vec<Seg>)> {
+        let path = &a.value;
+        let text = self.written(scope, path).unwrap_or_else(|| path.text());
+        let segs = match self.env.segs(scope, path) {
+            Ok(s) => s,
+            Err(d) => return self.fail(scope, d),
+        };
+        match self.env.resolve_family(scope, &segs, path.span) {
+            Ok((r, rest)) => Some((text, r, rest)),
+            Err(d) => self.fail(scope, d),
+        }
+    }
+
     pub(super) fn fail<T>(&mut self, scope: ScopeId, d: Diagnostic) -> Option<T> {
         self.error(scope, d);
         None
