@@ -412,7 +412,16 @@ pub fn sweep(spec: &SweepSpec, compile: &CompileWith, tick: &(dyn Fn(Tick) + Syn
     })
     .collect();
     let mut notes = Vec::new();
-    let primary = spec.methods[0];
+    let Some(&primary) = spec.methods.first() else {
+        return Sweep {
+            param: spec.param.clone(),
+            points,
+            refinements: Vec::new(),
+            edges: Vec::new(),
+            threshold: spec.threshold,
+            notes: vec!["no method was given".to_string()],
+        };
+    };
     let grid: Vec<&Point> = points.iter().filter(|p| p.method == primary).collect();
     let unstable = |p: &Point| p.max_real() > spec.threshold;
     // Brackets between neighbours of opposite stability (failed points break the chain).
