@@ -344,6 +344,37 @@ pub(crate) fn short(x: f64) -> String {
     format!("{v}")
 }
 
+/// Creates the CSV and the optional chart file before a long analysis, so that an unwritable
+/// path fails now (usage error), not after the runs.
+#[allow(clippy::type_complexity)]
+pub(crate) fn create_outputs<'a>(
+    csv: &str,
+    chart: Option<&'a str>,
+) -> Result<(std::fs::File, Option<(&'a str, std::fs::File)>), ExitCode> {
+    let csv_file = std::fs::File::create(csv)
+        .map_err(|e| usage(&format!("cannot create output file `{csv}`: {e}")))?;
+    let chart_file = match chart {
+        Some(p) => match std::fs::File::create(p) {
+            Ok(f) => Some((p, f)),
+            Err(e) => return Err(usage(&format!("cannot create chart file `{p}`: {e}"))),
+        },
+        None => None,
+    };
+    Ok((csv_file, chart_file))
+}
+
+/// Renders a chart into its file; a failure is reported, not fatal (the CSV is written).
+pub(crate) fn draw(path: &str, file: &mut std::fs::File, chart: &mbd::output::charts::Chart) {
+    match mbd::output::charts::render(chart) {
+        Ok(svg) => {
+            if let Err(e) = file.write_all(svg.as_bytes()) {
+                eprintln!("error: cannot write chart file `{path}`: {e}");
+            }
+        }
+        Err(e) => eprintln!("note: no chart drawn in `{path}`: {e}"),
+    }
+}
+
 fn usage(msg: &str) -> ExitCode {
     eprintln!("error: {msg}");
     ExitCode::from(EXIT_USAGE)

@@ -2,11 +2,14 @@
 //! file, runs the sweep through `mbd::study::sweep` with a progress bar, writes the CSV and the
 //! chart and prints the report. The analysis itself lives in the library.
 
-use super::{compile, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
+use super::{
+    compile, create_outputs, draw, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL,
+    EXIT_RUNTIME,
+};
 use mbd::model::Overrides;
 use mbd::output::charts::Series;
 use mbd::study::sweep::{self, Method, SweepSpec, Tick};
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
 use std::process::ExitCode;
 
 /// `mbd stability --help`.
@@ -209,16 +212,9 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
             Err(e) => return usage(&e),
         },
     };
-    let mut csv_file = match std::fs::File::create(&a.output) {
-        Ok(f) => f,
-        Err(e) => return usage(&format!("cannot create output file `{}`: {e}", a.output)),
-    };
-    let mut chart_file = match &a.chart {
-        Some(p) => match std::fs::File::create(p) {
-            Ok(f) => Some((p.as_str(), f)),
-            Err(e) => return usage(&format!("cannot create chart file `{p}`: {e}")),
-        },
-        None => None,
+    let (mut csv_file, mut chart_file) = match create_outputs(&a.output, a.chart.as_deref()) {
+        Ok(files) => files,
+        Err(code) => return code,
     };
     let spec = SweepSpec {
         param: param.clone(),
@@ -269,14 +265,7 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
     }
     if let Some((p, f)) = chart_file.as_mut() {
         let title = format!("{}: stability against {param}", c.model.name);
-        match mbd::output::charts::render(&result.chart(&title, reference)) {
-            Ok(svg) => {
-                if let Err(e) = f.write_all(svg.as_bytes()) {
-                    eprintln!("error: cannot write `{p}`: {e}");
-                }
-            }
-            Err(e) => eprintln!("warning: no chart written to `{p}`: {e}"),
-        }
+        draw(p, f, &result.chart(&title, reference));
     }
     print_report(&result);
     if result.points.iter().any(|p| p.failure.is_some()) {

@@ -2,13 +2,15 @@
 //! reference file, runs the study through `mbd::study`, writes its CSV and chart and prints
 //! the report. The study itself (runs, errors, orders, onsets) lives in the library.
 
-use super::{compile, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL, EXIT_RUNTIME};
+use super::{
+    compile, create_outputs, draw, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL,
+    EXIT_RUNTIME,
+};
 use mbd::model::Overrides;
 use mbd::study::compare::Samples;
 use mbd::study::convergence::{self, ConvergenceSpec, ReferenceSpec};
 use mbd::study::stability::{self, Detector, StabilitySpec};
 use mbd::study::{split_list, IntegratorItem, StepList};
-use std::io::Write;
 use std::process::ExitCode;
 
 /// `mbd study --help`.
@@ -157,16 +159,9 @@ pub fn study(a: StudyArgs) -> ExitCode {
         None => vec![c.model.solve.steps],
     };
     // Fail on unwritable outputs now, not after the runs.
-    let mut csv_file = match std::fs::File::create(&a.output) {
-        Ok(f) => f,
-        Err(e) => return usage(&format!("cannot create output file `{}`: {e}", a.output)),
-    };
-    let mut chart_file = match &a.chart {
-        Some(p) => match std::fs::File::create(p) {
-            Ok(f) => Some((p.as_str(), f)),
-            Err(e) => return usage(&format!("cannot create chart file `{p}`: {e}")),
-        },
-        None => None,
+    let (mut csv_file, mut chart_file) = match create_outputs(&a.output, a.chart.as_deref()) {
+        Ok(files) => files,
+        Err(code) => return code,
     };
     let (path, sets) = (a.model.as_str(), a.set.as_slice());
     let compile_job = |o: &Overrides| {
@@ -297,17 +292,6 @@ fn reference(a: &StudyArgs, c: &mbd::Compiled, until: f64) -> Result<ReferenceSp
 }
 
 /// Renders a chart into its (already created) file; a chart with nothing to draw is a note.
-fn draw(path: &str, file: &mut std::fs::File, chart: &mbd::output::charts::Chart) {
-    match mbd::output::charts::render(chart) {
-        Ok(svg) => {
-            if let Err(e) = file.write_all(svg.as_bytes()) {
-                eprintln!("error: cannot write chart file `{path}`: {e}");
-            }
-        }
-        Err(e) => eprintln!("note: no chart drawn in `{path}`: {e}"),
-    }
-}
-
 fn print_convergence(study: &convergence::Convergence, spec: &ConvergenceSpec) {
     match (&spec.reference, &study.finest) {
         (ReferenceSpec::Exact(_), _) => say(&format!(
