@@ -22,6 +22,7 @@ use super::linear::{LinearError, SparseLu};
 use super::newton::Newton;
 use super::rotations::{self, Transform};
 use super::se3;
+use super::start::StartMetric;
 use super::{
     FailureKind, Method, Notice, NoticeKind, RotationTreatment, RunStats, RuntimeFailure, Settings,
     StartMode,
@@ -124,10 +125,9 @@ pub struct Integrator<'s> {
     step_index: usize,
     /// The rotating node of each transformed block.
     block_node: Vec<usize>,
-    /// Weight of the stiffness in the constrained mass matrix: zero, or `beta h^2` when some
-    /// rotations carry no inertia (beams without rotary inertia), whose accelerations the
-    /// mass matrix alone leaves undetermined.
-    start_stiffness: f64,
+    /// The constrained mass matrix of the start: plain, or with the stiffness on the massless
+    /// motions that no joint holds ([`super::start`]).
+    start: StartMetric,
 }
 
 /// Why a step attempt failed, before it is turned into a [`RuntimeFailure`].
@@ -199,7 +199,7 @@ impl<'s> Integrator<'s> {
             },
             stats: RunStats::default(),
             step_index: 0,
-            start_stiffness: 0.0,
+            start: StartMetric::default(),
         };
         it.aug = it.scaling(set.dt);
         Ok(it)
@@ -263,17 +263,21 @@ impl<'s> Integrator<'s> {
     /// Solves `[M, s B^T; s B, 0] x = rhs` at `trial` (the constrained mass matrix, in the
     /// physical layout: virtual rotations).
     fn solve_constrained_mass(&mut self, rhs_and_x: &mut [f64]) -> Result<(), StepFailure> {
-        let c = TangentCoeffs {
-            mass: 1.0,
-            velocity: 0.0,
-            position: self.start_stiffness,
-            force_weight: 1.0,
-        };
-        self.asm.tangent(self.sys, &self.trial, self.aug, c);
-        self.lu
-            .factor(&self.asm.values)
-            .map_err(|e| self.singular(e))?;
-        self.lu.solve(rhs_and_x).map_err(|e| self.singular(e))
+        let rhs = rhs_and_x.to_vec();
+        loop {
+            self.start
+                .assemble(&mut self.asm, self.sys, &self.trial, self.aug);
+            let solved = match self.lu.factor(&self.asm.values) {
+                Ok(()) => self.lu.solve(rhs_and_x),
+                Err(e) => Err(e),
+            };
+            match solved {
+                Ok(()) => return Ok(()),
+                // A rigid body's massless motion held by a spring alone: regularize it too.
+                Err(_) if self.start.widen() => rhs_and_x.copy_from_slice(&rhs),
+                Err(e) => return Err(self.singular(e)),
+            }
+        }
     }
 
     /// The smallest mass-weighted correction of the coordinates that cancels `g` (the
@@ -357,7 +361,6 @@ impl<'s> Integrator<'s> {
         self.cur.clone_from(initial);
         self.trial.clone_from(initial);
         self.mid.clone_from(initial);
-        self.start_stiffness = 0.0;
         self.stats = RunStats::default();
         self.step_index = 0;
         self.aug = self.scaling(self.set.dt);
@@ -383,26 +386,16 @@ impl<'s> Integrator<'s> {
                 self.trial.a[i] = self.trial.rot[*node].dw[*axis];
             }
         }
-        // Rotations without inertia: the mass matrix alone does not determine them.
-        let c = TangentCoeffs {
-            mass: 1.0,
-            velocity: 0.0,
-            position: 0.0,
-            force_weight: 1.0,
-        };
-        self.asm.tangent(self.sys, &self.trial, self.aug, c);
-        let floor = 1e-12 * self.sys.mean_mass() * self.sys.length_scale.powi(2);
-        let massless = self.sys.unknowns.iter().enumerate().any(|(i, k)| {
-            matches!(k, UnknownKind::Rotation { .. })
-                && self
-                    .asm
-                    .pattern
-                    .slot(i, i)
-                    .is_some_and(|d| self.asm.values[d].abs() <= floor)
-        });
-        if massless {
-            self.start_stiffness = self.sc.beta * self.set.dt * self.set.dt;
-        }
+        // Multipliers are solved below; stale ones would enter the matrix's stiffness.
+        self.trial.lambda.iter_mut().for_each(|x| *x = 0.0);
+        // Motions without inertia that no joint holds get their stiffness in the start.
+        self.start = StartMetric::find(
+            &mut self.asm,
+            self.sys,
+            &self.trial,
+            self.aug,
+            self.sc.beta * self.set.dt * self.set.dt,
+        );
         // Positions: minimum mass-weighted correction, iterated (Gauss-Newton).
         let mut moved = None;
         for _ in 0..50 {

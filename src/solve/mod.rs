@@ -13,6 +13,7 @@ pub mod modes;
 mod newton;
 mod rotations;
 mod se3;
+mod start;
 
 pub use integrator::Integrator;
 
