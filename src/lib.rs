@@ -359,14 +359,114 @@ pub fn run_with_progress(
 }
 
 /// Modal analysis of a compiled model about its initial state (`mbd modes`): the modes by
-/// increasing natural frequency.
-pub fn modes(c: &Compiled) -> Result<solve::modes::Modes, Diagnostic> {
+/// increasing natural frequency. A state that is not a steady motion is refused (E0605), or
+/// with `frozen` gives the frozen-time eigenvalues, marked as such in [`solve::modes::Frame`].
+pub fn modes(c: &Compiled, frozen: bool) -> Result<solve::modes::Modes, Diagnostic> {
     let l = c.lowered.as_ref().map_err(Clone::clone)?;
-    solve::modes::modes(&l.system, &c.settings()).map_err(|f| c.failure_diagnostic(&f))
+    solve::modes::modes(&l.system, &c.settings(), frozen).map_err(|f| match f {
+        solve::modes::ModesFailure::Runtime(f) => c.failure_diagnostic(&f),
+        solve::modes::ModesFailure::Unsteady(why) => c.unsteady_diagnostic(&why),
+    })
+}
+
+/// `(x, y, z)` with six significant digits.
+fn vec3(v: [f64; 3]) -> String {
+    let f = |x: f64| format!("{:.6}", x + 0.0);
+    format!("({}, {}, {})", f(v[0]), f(v[1]), f(v[2]))
+}
+
+impl Compiled {
+    /// E0605: why the initial state has no modes, with the entities it names.
+    pub fn unsteady_diagnostic(&self, why: &solve::modes::Unsteady) -> Diagnostic {
+        use solve::modes::Unsteady;
+        let entity = |e: usize| {
+            self.lowered.as_ref().ok().and_then(|l| {
+                let x = l.system.entities.get(e)?;
+                Some((format!("{} `{}`", x.kind, x.name), l.provenance.spans.get(e).copied()))
+            })
+        };
+        let turn = |w: [f64; 3]| {
+            let n = (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]).sqrt();
+            if n == 0.0 {
+                "does not turn".to_string()
+            } else {
+                format!(
+                    "turns at {:.6} rad/s about {}",
+                    n,
+                    vec3([w[0] / n, w[1] / n, w[2] / n])
+                )
+            }
+        };
+        let (message, labels, hint) = match why {
+            Unsteady::Spins { a, wa, b, wb } => {
+                let (na, sa) = entity(*a).unzip();
+                let (nb, sb) = entity(*b).unzip();
+                (
+                    format!(
+                        "the model has no steady motion to take modes about: {} {} while {} {}; its linearized equations are periodic",
+                        na.clone().unwrap_or_default(),
+                        turn(*wa),
+                        nb.clone().unwrap_or_default(),
+                        turn(*wb)
+                    ),
+                    vec![(sa.flatten(), turn(*wa)), (sb.flatten(), turn(*wb))],
+                    "a rotor on a non-rotating flexible structure, or several rotors, is a periodic system: use `mbd stability` (Floquet analysis over one period) for its stability; `mbd modes --frozen` gives the eigenvalues of the equations frozen at t = 0, which are not its modes",
+                )
+            }
+            Unsteady::Velocities { entity: e, deviation } => {
+                let (n, sp) = entity(*e).unzip();
+                (
+                    format!(
+                        "the model has no steady motion to take modes about: the initial velocities are not a rigid rotation ({} moves {deviation:.3e} m/s off it)",
+                        n.unwrap_or_default()
+                    ),
+                    vec![(sp.flatten(), "moves off the rigid rotation".to_string())],
+                    "modes are taken about an equilibrium or a steady rotation: start every body at rest, or spinning together (`initial spin of ...`); `mbd modes --frozen` gives the eigenvalues of the equations frozen at t = 0",
+                )
+            }
+            Unsteady::Accelerates {
+                entity: e,
+                deviation,
+                angular,
+            } => {
+                let (n, sp) = entity(*e).unzip();
+                let unit = if *angular { "rad/s^2" } else { "m/s^2" };
+                (
+                    format!(
+                        "the model has no steady motion to take modes about: at t = 0 {} accelerates by {deviation:.3e} {unit} beyond a steady rotation (not an equilibrium)",
+                        n.unwrap_or_default()
+                    ),
+                    vec![(sp.flatten(), format!("accelerates by {deviation:.3e} {unit}"))],
+                    "modes are taken about an equilibrium or a steady rotation: start from one (the static deflection under gravity, the steady coning angle, constant drive rates), or use `mbd modes --frozen` for the eigenvalues of the equations frozen at t = 0",
+                )
+            }
+            Unsteady::Periodic { spin, change } => (
+                format!(
+                    "the model has no steady motion to take modes about: it {} rigidly, but its linearized equations change by {:.1e} of their size over a turn of one radian (gravity across the spin axis, a ground-fixed spring, load or support that is not symmetric about the axis); they are periodic",
+                    turn(*spin),
+                    change
+                ),
+                Vec::new(),
+                "use `mbd stability` (Floquet analysis over one period) for the stability of a periodic system; `mbd modes --frozen` gives the eigenvalues of the equations frozen at t = 0, which are not its modes",
+            ),
+        };
+        let mut d = Diagnostic::error(Code::E0605, message).hint(hint);
+        let mut any = false;
+        for (span, text) in labels {
+            if let Some(span) = span {
+                d = d.at(span, text);
+                any = true;
+            }
+        }
+        if !any {
+            d = d.at(self.model.solve.span, "the initial state of this model");
+        }
+        d
+    }
 }
 
 /// Writes the modes table: `mode, frequency_hz, omega_rad_s, damping_ratio, real_per_s,
-/// imag_rad_s` (the first `count`).
+/// imag_rad_s, frame` (the first `count`); `frame` is `inertial`, `rotating` or `frozen`.
 pub fn write_modes(
     m: &solve::modes::Modes,
     count: usize,
@@ -374,18 +474,20 @@ pub fn write_modes(
 ) -> std::io::Result<()> {
     writeln!(
         out,
-        "mode,frequency_hz,omega_rad_s,damping_ratio,real_per_s,imag_rad_s"
+        "mode,frequency_hz,omega_rad_s,damping_ratio,real_per_s,imag_rad_s,frame"
     )?;
+    let frame = m.frame.label();
     for (i, md) in m.modes.iter().take(count).enumerate() {
+        // `{:?}`: the shortest text that reads back to the same f64; `+ 0.0` drops `-0`.
         writeln!(
             out,
-            "{},{},{},{},{},{}",
+            "{},{:?},{:?},{:?},{:?},{:?},{frame}",
             i + 1,
-            md.frequency_hz(),
-            md.omega(),
-            md.damping_ratio(),
-            md.s.re,
-            md.s.im
+            md.frequency_hz() + 0.0,
+            md.omega() + 0.0,
+            md.damping_ratio() + 0.0,
+            md.s.re + 0.0,
+            md.s.im + 0.0
         )?;
     }
     Ok(())
@@ -401,7 +503,8 @@ pub fn write_shapes(
 ) -> std::io::Result<()> {
     let Ok(l) = &c.lowered else { return Ok(()) };
     let sys = &l.system;
-    writeln!(out, "mode,unknown,entity,kind,real,imag")?;
+    writeln!(out, "mode,unknown,entity,kind,real,imag,frame")?;
+    let frame = m.frame.label();
     for (i, md) in m.modes.iter().take(count).enumerate() {
         for (u, z) in md.shape.iter().enumerate() {
             let kind = match sys.unknowns[u] {
@@ -413,13 +516,13 @@ pub fn write_shapes(
             };
             writeln!(
                 out,
-                "{},{},{},{},{},{}",
+                "{},{},{},{},{:?},{:?},{frame}",
                 i + 1,
                 u,
                 sys.entities[sys.owners[u]].name,
                 kind,
-                z.re,
-                z.im
+                z.re + 0.0,
+                z.im + 0.0
             )?;
         }
     }

@@ -16,6 +16,7 @@ macro_rules! out_line {
     }};
 }
 
+mod modes_cmd;
 mod stability_cmd;
 mod study_cmd;
 
@@ -73,26 +74,10 @@ enum Command {
         #[arg(long, value_enum, default_value = "human")]
         format: Format,
     },
-    /// Natural frequencies and mode shapes about the initial state, as CSV.
-    Modes {
-        /// The model file.
-        model: String,
-        /// Write the frequency table here (default: standard output).
-        #[arg(short = 'o', long = "output")]
-        output: Option<String>,
-        /// Write the mode shapes here.
-        #[arg(long)]
-        shapes: Option<String>,
-        /// How many modes, by increasing frequency.
-        #[arg(long, default_value_t = 10)]
-        count: usize,
-        /// Override a param: NAME=VALUE.
-        #[arg(long = "set", value_name = "NAME=VALUE")]
-        set: Vec<String>,
-        /// Diagnostics format.
-        #[arg(long, value_enum, default_value = "human")]
-        format: Format,
-    },
+    /// Natural frequencies and mode shapes about the initial state, as CSV; with --sweep, a
+    /// fan plot against a param.
+    #[command(long_about = modes_cmd::LONG_ABOUT)]
+    Modes(modes_cmd::ModesArgs),
     /// Check a model and print a summary, or one stage of the compilation.
     Check {
         model: String,
@@ -200,21 +185,7 @@ fn main() -> ExitCode {
             output,
             title,
         } => plot(&csv, &channels, &output, title.as_deref()),
-        Command::Modes {
-            model,
-            output,
-            shapes,
-            count,
-            set,
-            format,
-        } => modes(
-            &model,
-            output.as_deref(),
-            shapes.as_deref(),
-            count,
-            &set,
-            format,
-        ),
+        Command::Modes(args) => modes_cmd::modes(args),
         Command::Run {
             model,
             output,
@@ -327,6 +298,70 @@ fn compile(
             Err(ExitCode::from(EXIT_MODEL))
         }
     }
+}
+
+/// `--sweep NAME=START:STOP:STEP`: the param and its values in SI. START, STOP and STEP may
+/// carry units (`Omega=200rpm:400rpm:100rpm`), each read as `--set NAME=VALUE` reads it (so
+/// its dimension is checked against the param's). Usage errors exit 2.
+pub(crate) fn sweep_values(
+    path: &str,
+    text: &str,
+    sets: &[String],
+    sweep: &str,
+    example: &str,
+) -> Result<(String, Vec<f64>), ExitCode> {
+    let Some((param, range)) = sweep.split_once('=') else {
+        return Err(usage(&format!(
+            "--sweep takes NAME=START:STOP:STEP, e.g. {example}; got `{sweep}`"
+        )));
+    };
+    let param = param.trim().to_string();
+    if sets
+        .iter()
+        .any(|s| s.split_once('=').map(|(n, _)| n.trim()) == Some(param.as_str()))
+    {
+        return Err(usage(&format!(
+            "--set {param}=... conflicts with --sweep {param}=...; drop one"
+        )));
+    }
+    let parts: Vec<&str> = range.split(':').map(str::trim).collect();
+    let [a, b, c] = parts[..] else {
+        return Err(usage(&format!(
+            "--sweep: the range `{range}` is not START:STOP:STEP"
+        )));
+    };
+    let si = |part: &str, what: &str| -> Result<f64, ExitCode> {
+        if let Ok(v) = part.parse::<f64>() {
+            return Ok(v);
+        }
+        // A value with a unit: the model reads it as it reads `--set`.
+        let mut all = sets.to_vec();
+        all.push(format!("{param}={part}"));
+        let fail = |why: String| usage(&format!("--sweep: the range's {what} `{part}`: {why}"));
+        match mbd::compile_with(path, text, &all, Overrides::default(), &FsLoader::new()) {
+            Ok(c) => c
+                .model
+                .params
+                .iter()
+                .find(|(n, _)| *n == param)
+                .and_then(|(_, v)| match v {
+                    mbd::model::Value::Scalar { value, .. } => Some(*value),
+                    _ => None,
+                })
+                .ok_or_else(|| fail(format!("the model has no scalar param `{param}`"))),
+            Err(f) => Err(fail(
+                f.diagnostics
+                    .iter()
+                    .find(|d| d.is_error())
+                    .map(|d| format!("{} {}", d.code.as_str(), d.message))
+                    .unwrap_or_else(|| "the model does not compile with it".to_string()),
+            )),
+        }
+    };
+    let (start, stop, step) = (si(a, "START")?, si(b, "STOP")?, si(c, "STEP")?);
+    let values = mbd::study::sweep::grid(start, stop, step)
+        .map_err(|e| usage(&format!("--sweep: {e}")))?;
+    Ok((param, values))
 }
 
 /// `println!` that does not panic when stdout is closed.
@@ -537,74 +572,6 @@ impl mbd::model::Loader for FsLoader {
         }
         Err(None)
     }
-}
-
-fn modes(
-    path: &str,
-    output: Option<&str>,
-    shapes: Option<&str>,
-    count: usize,
-    sets: &[String],
-    format: Format,
-) -> ExitCode {
-    let text = match read(path) {
-        Ok(t) => t,
-        Err(code) => return code,
-    };
-    let c = match compile(path, &text, sets, Overrides::default(), format) {
-        Ok(c) => c,
-        Err(code) => return code,
-    };
-    let m = match mbd::modes(&c) {
-        Ok(m) => m,
-        Err(d) => {
-            report(std::slice::from_ref(&d), &c.sources, format);
-            return ExitCode::from(if c.lowered.is_err() {
-                EXIT_MODEL
-            } else {
-                EXIT_RUNTIME
-            });
-        }
-    };
-    let open = |p: Option<&str>| -> Result<Box<dyn Write>, ExitCode> {
-        match p {
-            Some(p) => std::fs::File::create(p)
-                .map(|f| Box::new(f) as Box<dyn Write>)
-                .map_err(|e| usage(&format!("cannot create output file `{p}`: {e}"))),
-            None => Ok(Box::new(std::io::stdout().lock())),
-        }
-    };
-    let mut sink = match open(output) {
-        Ok(s) => s,
-        Err(code) => return code,
-    };
-    if let Err(e) = mbd::write_modes(&m, count, &mut sink) {
-        return usage(&format!("cannot write the modes: {e}"));
-    }
-    if let Some(p) = shapes {
-        let mut sink = match open(Some(p)) {
-            Ok(s) => s,
-            Err(code) => return code,
-        };
-        if let Err(e) = mbd::write_shapes(&c, &m, count, &mut sink) {
-            return usage(&format!("cannot write the shapes: {e}"));
-        }
-    }
-    if format == Format::Human {
-        eprintln!(
-            "{}: {} modes{}{}",
-            c.model.name,
-            m.modes.len().min(count),
-            m.spin
-                .map(|w| format!(
-                    ", referred to the frame spinning at ({:.6}, {:.6}, {:.6}) rad/s",
-                    w[0], w[1], w[2]
-                ))
-                .unwrap_or_default(),
-            output.map(|p| format!(" to {p}")).unwrap_or_default()
-        );
-    }
-    ExitCode::SUCCESS
 }
 
 fn run(

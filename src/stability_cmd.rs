@@ -3,7 +3,8 @@
 //! chart and prints the report. The analysis itself lives in the library.
 
 use super::{
-    compile, create_outputs, draw, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL,
+    compile, create_outputs, draw, read, report, say, short, sweep_values, usage, Format, FsLoader,
+    EXIT_MODEL,
     EXIT_RUNTIME,
 };
 use mbd::model::Overrides;
@@ -98,25 +99,14 @@ enum MethodArg {
 }
 
 pub fn stability(a: StabilityArgs) -> ExitCode {
-    let Some((param, range)) = a.sweep.split_once('=') else {
-        return usage(&format!(
-            "--sweep takes NAME=START:STOP:STEP, e.g. Omega_bar=0.8:2.6:0.05; got `{}`",
-            a.sweep
-        ));
+    let text = match read(&a.model) {
+        Ok(t) => t,
+        Err(code) => return code,
     };
-    let param = param.trim().to_string();
-    let values = match sweep::parse_range(range) {
-        Ok(v) => v,
-        Err(e) => return usage(&format!("--sweep: {e}")),
+    let (param, values) = match sweep_values(&a.model, &text, &a.set, &a.sweep, "Omega_bar=0.8:2.6:0.05") {
+        Ok(x) => x,
+        Err(code) => return code,
     };
-    if a.set
-        .iter()
-        .any(|s| s.split_once('=').map(|(n, _)| n.trim()) == Some(param.as_str()))
-    {
-        return usage(&format!(
-            "--set {param}=... conflicts with --sweep {param}=...; drop one"
-        ));
-    }
     if let Some(t) = a.period {
         if !(t.is_finite() && t > 0.0) {
             return usage(&format!(
@@ -155,10 +145,6 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
     if methods.contains(&Method::Prony) && a.samples < 12 {
         return usage("--samples must be at least 12");
     }
-    let text = match read(&a.model) {
-        Ok(t) => t,
-        Err(code) => return code,
-    };
     // The model compiles at the first value (reports its errors and warnings once).
     let mut first_sets = a.set.clone();
     first_sets.push(format!("{param}={}", values[0]));
@@ -248,13 +234,12 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         }
         b
     });
-    let tick = |t: Tick| {
-        if let Some(b) = &bar {
-            match t {
-                Tick::Planned(n) => b.inc_length(n as u64),
-                Tick::Done => b.inc(1),
-            }
-        }
+    // A bar on a terminal; elsewhere (a log, CI) a line per finished evaluation.
+    let tick = |t: Tick| match (&bar, t) {
+        (Some(b), Tick::Planned(n)) => b.inc_length(n as u64),
+        (Some(b), Tick::Done(_)) => b.inc(1),
+        (None, Tick::Done(line)) => eprintln!("{line}"),
+        (None, Tick::Planned(_)) => {}
     };
     let result = sweep::sweep(&spec, &compile_job, &tick);
     if let Some(b) = &bar {

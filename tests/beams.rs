@@ -119,7 +119,7 @@ fn modes_of(name: &str, text: &str, sets: &[String]) -> Vec<f64> {
         Ok(c) => c,
         Err(f) => panic!("{name}: {:?}", f.diagnostics),
     };
-    match mbd::modes(&c) {
+    match mbd::modes(&c, false) {
         Ok(m) => m.modes.iter().map(|x| x.omega()).collect(),
         Err(d) => panic!("{name}: {}", d.message),
     }

@@ -236,6 +236,17 @@ some direction, or constraints may be redundant.";
         "The requested combination of time integrator and options is not available: time finite \
 elements (`fet`) integrate rotations incrementally, so `rotations = conformal` applies to the \
 Newmark family (`hht`, `generalized_alpha`) only.";
+    E0605 = "E0605", "no steady motion for modal analysis",
+        "`mbd modes` linearizes the equations about the initial state, and that linearization has \
+modes only if the state is a steady motion: an equilibrium (at rest, or a uniform translation), \
+or a rigid rotation of the whole model at one rate about one axis with every acceleration the \
+centripetal one, in a model that is symmetric about that axis (then the equations are constant \
+in the frame turning with it). A rotor on a non-rotating flexible structure, two rotors, gravity \
+across the spin axis, or a support that is not symmetric about it make the equations periodic: \
+their stability is Floquet analysis over one period, `mbd stability`. A state that accelerates \
+(a pendulum released from the side, a structure not yet deflected under its load) is not an \
+equilibrium. `mbd modes --frozen` gives the eigenvalues of the equations frozen at t = 0 anyway, \
+marked `frozen` on every output: they are not the system's modes.";
     W0201 = "W0201", "unused param",
         "A param is declared but nothing uses it, not even an output. Remove it, or use it.";
     W0202 = "W0202", "unused declaration",

@@ -405,13 +405,20 @@ fn probe(
             joint,
             quantity: q,
             component,
+            ref axes,
         } => {
             let element = joint_element[joint];
+            let axes = axes.as_ref().map(|m| lw.end(m, &m3(&m.world_axes)));
             match q {
-                JointQuantity::Force => Probe::JointForce { element, component },
+                JointQuantity::Force => Probe::JointForce {
+                    element,
+                    component,
+                    axes,
+                },
                 JointQuantity::Moment => Probe::JointMoment {
                     element,
                     component: component.unwrap_or(0),
+                    axes,
                 },
                 JointQuantity::Angle => Probe::JointAngle { element },
                 JointQuantity::Rate => Probe::JointRate { element },

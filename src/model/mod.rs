@@ -191,7 +191,7 @@ pub enum Attach {
 }
 
 /// A point with axes, fixed on a ground, a body or a beam.
-#[derive(Clone, Debug, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Marker {
     pub attach: Attach,
     /// Offset from the attachment's reference point, in its frame.
@@ -391,6 +391,10 @@ pub enum Probe {
         quantity: JointQuantity,
         /// The vector component, for force and moment of joints with several multipliers.
         component: Option<usize>,
+        /// `force.in(MARKER)`: the component in the axes of this marker (as they turn), not
+        /// in inertial axes.
+        #[serde(skip_serializing_if = "Option::is_none")]
+        axes: Option<Box<Marker>>,
     },
     Energy {
         kind: EnergyKind,

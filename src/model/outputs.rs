@@ -4,7 +4,7 @@ use super::build::{Builder, Built};
 use super::env::{Ref, ScopeId, Seg};
 use super::*;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
-use crate::syntax::ast::{OutputItem, OutputTarget, Path};
+use crate::syntax::ast::{ExprKind, MarkerRef, OutputItem, OutputTarget, Path, Segment};
 use std::collections::HashMap;
 
 pub(super) const AXES: [&str; 3] = ["x", "y", "z"];
@@ -24,6 +24,39 @@ const RIGID_Q: &[&str] = &[
     "rotation",
     "crv",
 ];
+
+/// Splits `a.force.in(m).x` into the path before `.in(...)`, the marker, and the segments
+/// after it. Only a path argument is a marker (`in(hub)`, `in(rotor.blade[1].start)`).
+fn split_in(path: &Path) -> Option<(Path, MarkerRef, Vec<Segment>)> {
+    let k = path
+        .segments
+        .iter()
+        .enumerate()
+        .skip(1)
+        .find(|(_, s)| s.name.name == "in" && s.index.is_none() && s.arg.is_some())?
+        .0;
+    let arg = path.segments[k].arg.as_deref()?;
+    let marker_path = match &arg.kind {
+        ExprKind::Path { path } => path.clone(),
+        _ => Path {
+            segments: Vec::new(),
+            span: arg.span,
+        },
+    };
+    let head = Path {
+        segments: path.segments[..k].to_vec(),
+        span: path.span,
+    };
+    Some((
+        head,
+        MarkerRef {
+            path: marker_path,
+            offset: None,
+            span: arg.span,
+        },
+        path.segments[k + 1..].to_vec(),
+    ))
+}
 
 impl Builder<'_> {
     pub(super) fn outputs(&mut self, items: &[(OutputItem, ScopeId)]) -> Vec<OutputChannel> {
@@ -86,8 +119,77 @@ impl Builder<'_> {
         out
     }
 
-    /// The path as the column name: indices evaluated, `rotor.lag[1].angle`.
+    /// `joint.force.in(MARKER)`, `joint.moment.in(MARKER).x`: the vector in the marker's axes.
+    fn probes_in(
+        &mut self,
+        scope: ScopeId,
+        path: &Path,
+        head: &Path,
+        marker: &MarkerRef,
+        tail: &[Segment],
+    ) -> Option<Vec<(String, Probe)>> {
+        let mut plain = head.clone();
+        plain.segments.extend_from_slice(tail);
+        let probes = self.probes(scope, &plain)?;
+        let vector = probes.iter().all(|(_, p)| {
+            matches!(
+                p,
+                Probe::Joint {
+                    quantity: JointQuantity::Force | JointQuantity::Moment,
+                    component: Some(_),
+                    ..
+                }
+            )
+        });
+        if !vector {
+            self.error(
+                scope,
+                Diagnostic::error(
+                    Code::E0212,
+                    format!("`{}`: `.in(MARKER)` applies to a joint's force or moment", path.text()),
+                )
+                .at(marker.span, "axes for a quantity that has none")
+                .hint("write it after a joint's vector load: `hinge.force.in(hub)`, `hinge.moment.in(blade).z` (a distance joint's force is a scalar tension)"),
+            );
+            return None;
+        }
+        let m = Box::new(self.marker(scope, marker)?);
+        Some(
+            probes
+                .into_iter()
+                .map(|(suffix, p)| match p {
+                    Probe::Joint {
+                        joint,
+                        quantity,
+                        component,
+                        ..
+                    } => (
+                        suffix,
+                        Probe::Joint {
+                            joint,
+                            quantity,
+                            component,
+                            axes: Some(m.clone()),
+                        },
+                    ),
+                    other => (suffix, other),
+                })
+                .collect(),
+        )
+    }
+
+    /// The path as the column name: indices evaluated, `rotor.lag[1].angle`,
+    /// `lag.force.in(hub).x`.
     pub(super) fn written(&mut self, scope: ScopeId, path: &Path) -> Option<String> {
+        if let Some((head, marker, tail)) = split_in(path) {
+            let mut text = self.written(scope, &head)?;
+            text.push_str(&format!(".in({})", self.written(scope, &marker.path)?));
+            for s in &tail {
+                text.push('.');
+                text.push_str(&s.name.name);
+            }
+            return Some(text);
+        }
         let segs = self.env.segs(scope, path).ok()?;
         Some(
             segs.iter()
@@ -192,6 +294,9 @@ impl Builder<'_> {
     /// The probes a path names, each with its column suffix: `.x` for a component of a
     /// vector, empty for a single column.
     fn probes(&mut self, scope: ScopeId, path: &Path) -> Option<Vec<(String, Probe)>> {
+        if let Some((head, marker, tail)) = split_in(path) {
+            return self.probes_in(scope, path, &head, &marker, &tail);
+        }
         if let Some(single) = path.single() {
             let energy = match single.name.as_str() {
                 "kinetic_energy" => Some(EnergyKind::Kinetic),
@@ -417,6 +522,7 @@ impl Builder<'_> {
                             joint: j,
                             quantity,
                             component: None,
+                            axes: None,
                         },
                     )]);
                 }
@@ -424,6 +530,7 @@ impl Builder<'_> {
                     joint: j,
                     quantity,
                     component: Some(c),
+                    axes: None,
                 })
             }
             Built::Ground(_) => {

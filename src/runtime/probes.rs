@@ -118,16 +118,22 @@ pub enum Probe {
         quantity: ProbeQuantity,
         component: usize,
     },
-    /// The joint's force on its second end (inertial component), or for a one-row joint
-    /// (`component: None`) the row's force `mu` (a distance joint's tension).
+    /// The force the joint applies on its second end (inertial component, or in the axes of
+    /// `axes` as they turn), or for a one-row joint (`component: None`) the row's force `mu`
+    /// (a distance joint's tension).
     JointForce {
         element: usize,
         component: Option<usize>,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        axes: Option<End>,
     },
-    /// The joint's moment on its second end about the marker point (inertial component).
+    /// The moment the joint applies on its second end about its marker point (inertial
+    /// component, or in the axes of `axes`).
     JointMoment {
         element: usize,
         component: usize,
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        axes: Option<End>,
     },
     /// The revolute's angle or the prismatic joint's displacement.
     JointAngle {
@@ -167,6 +173,14 @@ pub enum Probe {
     },
 }
 
+/// An inertial vector in the axes of `axes` at `st` (unchanged without).
+fn resolve(v: V3, axes: Option<&End>, st: &State) -> V3 {
+    match axes {
+        Some(e) => e.kin(st).e.transpose() * v,
+        None => v,
+    }
+}
+
 impl System {
     /// The value of a probe in a state.
     pub fn probe(&self, probe: &Probe, st: &State, aug: Augment) -> f64 {
@@ -191,15 +205,23 @@ impl System {
                     },
                 }
             }
-            Probe::JointForce { element, component } => match &self.elements[*element] {
+            Probe::JointForce {
+                element,
+                component,
+                axes,
+            } => match &self.elements[*element] {
                 Element::Joint(j) => match component {
-                    Some(c) => j.reaction(st, aug).0[*c],
+                    Some(c) => resolve(j.reaction(st, aug).0, axes.as_ref(), st)[*c],
                     None => j.multiplier_force(st, aug, 0),
                 },
                 _ => f64::NAN,
             },
-            Probe::JointMoment { element, component } => match &self.elements[*element] {
-                Element::Joint(j) => j.reaction(st, aug).1[*component],
+            Probe::JointMoment {
+                element,
+                component,
+                axes,
+            } => match &self.elements[*element] {
+                Element::Joint(j) => resolve(j.reaction(st, aug).1, axes.as_ref(), st)[*component],
                 _ => f64::NAN,
             },
             Probe::JointAngle { element } => self.joint_angle(*element, st, false),

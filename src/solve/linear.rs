@@ -189,27 +189,84 @@ pub fn least_squares(
 /// Generalized eigenvalues `alpha / beta` and right eigenvectors of `A z = s B z` for real
 /// column-major `n x n` matrices (QZ): `(alpha, beta, vector)` with complex numbers as
 /// `(re, im)`.
+///
+/// Calls faer's `gevd_real` with its own workspace: the one `Mat::generalized_eigen` sizes
+/// omits the `n x 2` block of the eigenvector back-substitution, which is the largest need
+/// for `n <= 2` (faer 0.24 panics there, "buffer is not large enough").
 #[allow(clippy::type_complexity)]
 pub fn generalized_eigen(
     a: &[f64],
     b: &[f64],
     n: usize,
 ) -> Option<Vec<((f64, f64), (f64, f64), Vec<(f64, f64)>)>> {
-    let am = faer::Mat::<f64>::from_fn(n, n, |i, j| a[j * n + i]);
-    let bm = faer::Mat::<f64>::from_fn(n, n, |i, j| b[j * n + i]);
-    let ev = am.generalized_eigen(&bm).ok()?;
-    let (sa, sb, u) = (ev.S_a().column_vector(), ev.S_b().column_vector(), ev.U());
-    Some(
-        (0..n)
-            .map(|e| {
-                (
-                    (sa[e].re, sa[e].im),
-                    (sb[e].re, sb[e].im),
-                    (0..n).map(|i| (u[(i, e)].re, u[(i, e)].im)).collect(),
-                )
-            })
-            .collect(),
+    use faer::linalg::evd::ComputeEigenvectors;
+    if n == 0 {
+        return Some(Vec::new());
+    }
+    let mut am = faer::Mat::<f64>::from_fn(n, n, |i, j| a[j * n + i]);
+    let mut bm = faer::Mat::<f64>::from_fn(n, n, |i, j| b[j * n + i]);
+    let mut u = faer::Mat::<f64>::zeros(n, n);
+    let (mut re, mut im, mut beta) = (
+        faer::diag::Diag::<f64>::zeros(n),
+        faer::diag::Diag::<f64>::zeros(n),
+        faer::diag::Diag::<f64>::zeros(n),
+    );
+    let req = StackReq::all_of(&[
+        faer::linalg::gevd::gevd_scratch::<f64>(
+            n,
+            ComputeEigenvectors::No,
+            ComputeEigenvectors::Yes,
+            Par::Seq,
+            Default::default(),
+        ),
+        faer::linalg::temp_mat_scratch::<f64>(n, 2),
+        faer::linalg::temp_mat_scratch::<f64>(n, 2),
+    ]);
+    let mut mem = MemBuffer::try_new(req).ok()?;
+    faer::linalg::gevd::gevd_real(
+        am.as_mut(),
+        bm.as_mut(),
+        re.as_mut(),
+        im.as_mut(),
+        beta.as_mut(),
+        None,
+        Some(u.as_mut()),
+        Par::Seq,
+        MemStack::new(&mut mem),
+        Default::default(),
     )
+    .ok()?;
+    let (re, im, beta) = (
+        re.column_vector(),
+        im.column_vector(),
+        beta.column_vector(),
+    );
+    // Complex pairs occupy two columns: the real and the imaginary part of the first.
+    let mut out = Vec::with_capacity(n);
+    let mut j = 0;
+    while j < n {
+        if im[j] == 0.0 || j + 1 == n {
+            out.push((
+                (re[j], 0.0),
+                (beta[j], 0.0),
+                (0..n).map(|i| (u[(i, j)], 0.0)).collect(),
+            ));
+            j += 1;
+        } else {
+            out.push((
+                (re[j], im[j]),
+                (beta[j], 0.0),
+                (0..n).map(|i| (u[(i, j)], u[(i, j + 1)])).collect(),
+            ));
+            out.push((
+                (re[j], -im[j]),
+                (beta[j], 0.0),
+                (0..n).map(|i| (u[(i, j)], -u[(i, j + 1)])).collect(),
+            ));
+            j += 2;
+        }
+    }
+    Some(out)
 }
 
 #[cfg(test)]
@@ -238,5 +295,39 @@ mod tests {
         let mut rhs = [12.0, 8.0, 2.0];
         lu.solve(&mut rhs).expect("solve");
         assert!(rhs.iter().all(|x| (x - 1.0).abs() < 1e-14));
+    }
+
+    #[test]
+    fn generalized_eigenvalues_of_one_and_two_unknowns() {
+        // A single oscillator as a first-order pencil: [0 1; -k 0] z = s [1 0; 0 m] z with
+        // k = 4, m = 1: s = +-2i. And the 1x1 pencil 3 z = s 2 z.
+        let a = [0.0, -4.0, 1.0, 0.0];
+        let b = [1.0, 0.0, 0.0, 1.0];
+        let ev = generalized_eigen(&a, &b, 2).expect("qz");
+        let mut s: Vec<(f64, f64)> = ev
+            .iter()
+            .map(|((ar, ai), (br, _), _)| (ar / br, ai / br))
+            .collect();
+        s.sort_by(|p, q| p.1.total_cmp(&q.1));
+        assert!((s[0].0).abs() < 1e-14 && (s[0].1 + 2.0).abs() < 1e-14, "{s:?}");
+        assert!((s[1].0).abs() < 1e-14 && (s[1].1 - 2.0).abs() < 1e-14, "{s:?}");
+        // The eigenvector satisfies A z = s B z.
+        for ((ar, ai), (br, _), z) in &ev {
+            let (sr, si) = (ar / br, ai / br);
+            for i in 0..2 {
+                let (mut lr, mut li, mut rr, mut ri) = (0.0, 0.0, 0.0, 0.0);
+                for j in 0..2 {
+                    lr += a[j * 2 + i] * z[j].0;
+                    li += a[j * 2 + i] * z[j].1;
+                    let (bz_r, bz_i) = (b[j * 2 + i] * z[j].0, b[j * 2 + i] * z[j].1);
+                    rr += sr * bz_r - si * bz_i;
+                    ri += sr * bz_i + si * bz_r;
+                }
+                assert!((lr - rr).abs() < 1e-12 && (li - ri).abs() < 1e-12);
+            }
+        }
+        let one = generalized_eigen(&[3.0], &[2.0], 1).expect("qz");
+        assert_eq!(one.len(), 1);
+        assert!((one[0].0 .0 / one[0].1 .0 - 1.5).abs() < 1e-15);
     }
 }

@@ -11,6 +11,7 @@
 
 pub mod compare;
 pub mod convergence;
+pub mod fan;
 pub mod prony;
 pub mod stability;
 pub mod sweep;

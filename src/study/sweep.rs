@@ -58,11 +58,12 @@ pub struct SweepSpec {
     pub refine: usize,
 }
 
-/// Progress of a sweep: evaluations planned (added to the total) or done.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+/// Progress of a sweep: evaluations planned (added to the total), or one done, with a line
+/// that says what it found.
+#[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Tick {
     Planned(usize),
-    Done,
+    Done(String),
 }
 
 /// The exponents found at one value by one method.
@@ -145,7 +146,15 @@ pub fn parse_range(text: &str) -> Result<Vec<f64>, String> {
             .filter(|v| v.is_finite())
             .ok_or_else(|| format!("the range's {what} `{s}` is not a number"))
     };
-    let (start, stop, step) = (num(a, "START")?, num(b, "STOP")?, num(c, "STEP")?);
+    grid(num(a, "START")?, num(b, "STOP")?, num(c, "STEP")?)
+}
+
+/// The values from `start` to `stop` (inclusive, within a millionth of a step) by `step`.
+pub fn grid(start: f64, stop: f64, step: f64) -> Result<Vec<f64>, String> {
+    let text = format!("{start}:{stop}:{step}");
+    if !(start.is_finite() && stop.is_finite() && step.is_finite()) {
+        return Err(format!("the range {text} is not finite"));
+    }
     if step == 0.0 || (stop - start) * step < 0.0 {
         return Err(format!(
             "the range {text} does not reach STOP from START in steps of STEP"
@@ -216,27 +225,35 @@ fn evaluate(
         detail: String::new(),
     };
     let set = format!("{}={value}", spec.param);
-    let c = match compile(&[set]) {
-        Ok(c) => c,
-        Err(e) => {
-            point.failure = Some(e);
-            return point;
-        }
-    };
-    let start = thread_cpu_seconds();
-    let result = match method {
-        Method::Floquet => floquet_point(spec, &c),
-        Method::Prony => prony_point(spec, c),
-    };
-    point.cpu_s = thread_cpu_seconds() - start;
-    match result {
-        Ok((modes, detail)) => {
-            point.modes = modes;
-            point.detail = detail;
+    match compile(&[set]) {
+        Ok(c) => {
+            let start = thread_cpu_seconds();
+            let result = match method {
+                Method::Floquet => floquet_point(spec, &c),
+                Method::Prony => prony_point(spec, c),
+            };
+            point.cpu_s = thread_cpu_seconds() - start;
+            match result {
+                Ok((modes, detail)) => {
+                    point.modes = modes;
+                    point.detail = detail;
+                }
+                Err(e) => point.failure = Some(e),
+            }
         }
         Err(e) => point.failure = Some(e),
     }
-    tick(Tick::Done);
+    let summary = match &point.failure {
+        Some(f) => format!("{} = {value} ({}): failed: {f}", spec.param, method.name()),
+        None => format!(
+            "{} = {value} ({}): largest Re s {:.4e} 1/s, {:.2} s CPU",
+            spec.param,
+            method.name(),
+            point.max_real(),
+            point.cpu_s
+        ),
+    };
+    tick(Tick::Done(summary));
     point
 }
 
