@@ -369,10 +369,24 @@ pub fn modes(c: &Compiled, frozen: bool) -> Result<solve::modes::Modes, Diagnost
     })
 }
 
-/// `(x, y, z)` with six significant digits.
-fn vec3(v: [f64; 3]) -> String {
-    let f = |x: f64| format!("{:.6}", x + 0.0);
-    format!("({}, {}, {})", f(v[0]), f(v[1]), f(v[2]))
+/// A number with at most six significant digits, no trailing zeros: `31.4`, `0.001`.
+fn num6(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{}", x + 0.0);
+    }
+    let v: f64 = format!("{x:.5e}").parse().unwrap_or(x);
+    format!("{}", v + 0.0)
+}
+
+/// A direction: `z`, `-x`, or `(0.6, 0.8, 0)`.
+fn direction(v: [f64; 3]) -> String {
+    for (k, name) in ["x", "y", "z"].iter().enumerate() {
+        let others = (0..3).filter(|&j| j != k).all(|j| v[j].abs() < 1e-9);
+        if others && (v[k].abs() - 1.0).abs() < 1e-9 {
+            return format!("{}{name}", if v[k] < 0.0 { "-" } else { "" });
+        }
+    }
+    format!("({}, {}, {})", num6(v[0]), num6(v[1]), num6(v[2]))
 }
 
 impl Compiled {
@@ -382,7 +396,10 @@ impl Compiled {
         let entity = |e: usize| {
             self.lowered.as_ref().ok().and_then(|l| {
                 let x = l.system.entities.get(e)?;
-                Some((format!("{} `{}`", x.kind, x.name), l.provenance.spans.get(e).copied()))
+                Some((
+                    format!("{} `{}`", x.kind, x.name),
+                    l.provenance.spans.get(e).copied(),
+                ))
             })
         };
         let turn = |w: [f64; 3]| {
@@ -391,9 +408,9 @@ impl Compiled {
                 "does not turn".to_string()
             } else {
                 format!(
-                    "turns at {:.6} rad/s about {}",
-                    n,
-                    vec3([w[0] / n, w[1] / n, w[2] / n])
+                    "turns at {} rad/s about {}",
+                    num6(n),
+                    direction([w[0] / n, w[1] / n, w[2] / n])
                 )
             }
         };

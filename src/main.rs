@@ -359,8 +359,8 @@ pub(crate) fn sweep_values(
         }
     };
     let (start, stop, step) = (si(a, "START")?, si(b, "STOP")?, si(c, "STEP")?);
-    let values = mbd::study::sweep::grid(start, stop, step)
-        .map_err(|e| usage(&format!("--sweep: {e}")))?;
+    let values =
+        mbd::study::sweep::grid(start, stop, step).map_err(|e| usage(&format!("--sweep: {e}")))?;
     Ok((param, values))
 }
 

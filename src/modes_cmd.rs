@@ -2,8 +2,8 @@
 //! `mbd::modes` (one state) and `mbd::study::fan` (a sweep).
 
 use crate::{
-    compile, create_outputs, draw, read, report, sweep_values, usage, Format, FsLoader,
-    EXIT_MODEL, EXIT_RUNTIME,
+    compile, create_outputs, draw, read, report, sweep_values, usage, Format, FsLoader, EXIT_MODEL,
+    EXIT_RUNTIME,
 };
 use mbd::model::Overrides;
 use mbd::solve::modes::{Frame, Modes};

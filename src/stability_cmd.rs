@@ -4,8 +4,7 @@
 
 use super::{
     compile, create_outputs, draw, read, report, say, short, sweep_values, usage, Format, FsLoader,
-    EXIT_MODEL,
-    EXIT_RUNTIME,
+    EXIT_MODEL, EXIT_RUNTIME,
 };
 use mbd::model::Overrides;
 use mbd::output::charts::Series;
@@ -103,10 +102,11 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         Ok(t) => t,
         Err(code) => return code,
     };
-    let (param, values) = match sweep_values(&a.model, &text, &a.set, &a.sweep, "Omega_bar=0.8:2.6:0.05") {
-        Ok(x) => x,
-        Err(code) => return code,
-    };
+    let (param, values) =
+        match sweep_values(&a.model, &text, &a.set, &a.sweep, "Omega_bar=0.8:2.6:0.05") {
+            Ok(x) => x,
+            Err(code) => return code,
+        };
     if let Some(t) = a.period {
         if !(t.is_finite() && t > 0.0) {
             return usage(&format!(

@@ -73,6 +73,7 @@ const ELSEWHERE: &[Code] = &[
     Code::E0602,
     Code::E0603,
     Code::E0604,
+    Code::E0605,
     Code::W0601,
     Code::W0602,
 ];
@@ -350,4 +351,21 @@ fn runtime_diagnostics_name_when_and_where() {
         assert_eq!(codes, vec![code], "{name}");
         insta::assert_snapshot!(name, rendered);
     }
+}
+
+#[test]
+fn modes_refuses_a_rotor_on_a_still_mast_and_names_both() {
+    let text = crate::modes::teetering(true);
+    let c = match mbd::compile("teeter.mbd", &text, &[], Overrides::default()) {
+        Ok(c) => c,
+        Err(f) => panic!("teeter does not compile: {:?}", f.diagnostics),
+    };
+    let d = match mbd::modes(&c, false) {
+        Err(d) => d,
+        Ok(_) => panic!("modes of a rotor on an elastic mast must be refused"),
+    };
+    assert_eq!(d.code, Code::E0605);
+    // The still mast and the turning hub, each at its declaration.
+    assert_eq!(d.labels.len(), 2, "{:?}", d.labels);
+    insta::assert_snapshot!("modes_not_steady", render_all(&[d], &c.sources));
 }

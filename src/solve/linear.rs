@@ -236,11 +236,7 @@ pub fn generalized_eigen(
         Default::default(),
     )
     .ok()?;
-    let (re, im, beta) = (
-        re.column_vector(),
-        im.column_vector(),
-        beta.column_vector(),
-    );
+    let (re, im, beta) = (re.column_vector(), im.column_vector(), beta.column_vector());
     // Complex pairs occupy two columns: the real and the imaginary part of the first.
     let mut out = Vec::with_capacity(n);
     let mut j = 0;
@@ -309,8 +305,14 @@ mod tests {
             .map(|((ar, ai), (br, _), _)| (ar / br, ai / br))
             .collect();
         s.sort_by(|p, q| p.1.total_cmp(&q.1));
-        assert!((s[0].0).abs() < 1e-14 && (s[0].1 + 2.0).abs() < 1e-14, "{s:?}");
-        assert!((s[1].0).abs() < 1e-14 && (s[1].1 - 2.0).abs() < 1e-14, "{s:?}");
+        assert!(
+            (s[0].0).abs() < 1e-14 && (s[0].1 + 2.0).abs() < 1e-14,
+            "{s:?}"
+        );
+        assert!(
+            (s[1].0).abs() < 1e-14 && (s[1].1 - 2.0).abs() < 1e-14,
+            "{s:?}"
+        );
         // The eigenvector satisfies A z = s B z.
         for ((ar, ai), (br, _), z) in &ev {
             let (sr, si) = (ar / br, ai / br);

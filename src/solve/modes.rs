@@ -191,7 +191,8 @@ pub fn modes(sys: &System, set: &Settings, frozen: bool) -> Result<Modes, ModesF
                     change: periodic,
                 })
             } else {
-                relax(sys, &mut it, &st, &motion)?.map(|moved| (motion, moved))
+                relax(sys, &mut it, &st, &motion, set.increment_tolerance)?
+                    .map(|moved| (motion, moved))
             }
         }
     };
@@ -365,24 +366,28 @@ fn relax(
     it: &mut Integrator,
     st: &State,
     motion: &Motion,
+    tolerance: f64,
 ) -> Result<Result<f64, Unsteady>, RuntimeFailure> {
     let (tr, angles) = coordinates(sys);
     let w = motion.spin;
     let ell = sys.length_scale.max(f64::MIN_POSITIVE);
     let first = deviation(sys, st, w);
-    let steady = |d: &(f64, Option<usize>, bool, f64)| {
-        let dev = if d.2 { d.0 * ell } else { d.0 };
-        dev <= MOTION_TOL * d.3.max(f64::MIN_POSITIVE)
+    let moved = |now: &State| {
+        let far = tr
+            .iter()
+            .map(|&i| (triplet(&now.q, i) - triplet(&st.q, i)).norm())
+            .fold(0.0, f64::max);
+        // Below a billionth of the model's size it did not move.
+        if far > 1e-9 * ell {
+            far
+        } else {
+            0.0
+        }
     };
     for _ in 0..RELAX_ITERATIONS {
         let now = it.state().clone();
-        if steady(&deviation(sys, &now, w)) {
-            let moved = tr
-                .iter()
-                .map(|&i| (triplet(&now.q, i) - triplet(&st.q, i)).norm())
-                .fold(0.0, f64::max);
-            // Below a billionth of the model's size it did not move.
-            return Ok(Ok(if moved > 1e-9 * ell { moved } else { 0.0 }));
+        if deviation(sys, &now, w).0 == 0.0 {
+            return Ok(Ok(moved(&now)));
         }
         let lin = it.linearize();
         let nf = lin.unknowns.len();
@@ -417,17 +422,45 @@ fn relax(
             break;
         };
         let n = DMatrix::<f64>::from_column_slice(nf, r, &basis);
+        let d = nalgebra::DVector::from_vec(d);
+        // The steady accelerations must satisfy the joints: a deviation across them (a
+        // pendulum swinging through the bottom cannot move steadily) is no imbalance that
+        // moving cancels.
+        let across = &d - &n * (n.transpose() * &d);
+        let scale = deviation(sys, &now, w).3.max(f64::MIN_POSITIVE);
+        if across.iter().fold(0.0f64, |a, x| a.max(x.abs())) > 1e-3 * scale {
+            break;
+        }
         let kr = n.transpose() * &k * &n;
-        let rhs = -(n.transpose() * (&m * nalgebra::DVector::from_vec(d)));
+        let rhs = -(n.transpose() * (&m * &d));
         let Some(y) = least_squares(kr.transpose().as_slice(), r, r, rhs.as_slice(), 1, 1e-12)
         else {
             break;
         };
-        let dq = &n * nalgebra::DVector::from_vec(y);
-        // The step, at most a tenth of the model's length (or a tenth of a radian).
+        let y = nalgebra::DVector::from_vec(y);
+        // Moving can cancel the imbalance only if it is not in the null space of `K_r` (a free
+        // body under a constant force accelerates wherever it is).
+        let resolvable = (&kr * &y - &rhs).norm() <= 0.5 * rhs.norm();
+        let dq = &n * y;
         let big = dq.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-        let cut = if big > 0.1 * ell { 0.1 * ell / big } else { 1.0 };
-        let at = |i: usize| if pos[i] == usize::MAX { 0.0 } else { dq[pos[i]] * cut };
+        // Below the Newton tolerance the imbalance left is round-off (a stiff beam's stretch
+        // carries about 1e-7 of its accelerations as noise).
+        if resolvable && big <= tolerance * ell {
+            return Ok(Ok(moved(&now)));
+        }
+        // The step, at most a tenth of the model's length (or a tenth of a radian).
+        let cut = if big > 0.1 * ell {
+            0.1 * ell / big
+        } else {
+            1.0
+        };
+        let at = |i: usize| {
+            if pos[i] == usize::MAX {
+                0.0
+            } else {
+                dq[pos[i]] * cut
+            }
+        };
         let mut next = now.clone();
         for &i in &tr {
             let x = triplet(&now.q, i) + V3::new(at(i), at(i + 1), at(i + 2));
@@ -524,7 +557,11 @@ fn periodic_change(
             tn.transpose() * dense(x1, nf) * &tn,
         )
     };
-    let (m, g, k) = (reduce(&lin0.m, &lin1.m), reduce(&lin0.g, &lin1.g), reduce(&lin0.k, &lin1.k));
+    let (m, g, k) = (
+        reduce(&lin0.m, &lin1.m),
+        reduce(&lin0.g, &lin1.g),
+        reduce(&lin0.k, &lin1.k),
+    );
     // Each change against the size of its matrix's part in the eigenproblem: `G` against
     // `M Omega` and `sqrt(M K)`, `K` against `M Omega^2`, so a matrix that is zero (no damping)
     // does not turn round-off into a change.

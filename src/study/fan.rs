@@ -70,8 +70,7 @@ pub fn fan(spec: &FanSpec, compile: &CompileWith, tick: &(dyn Fn(Tick) + Sync)) 
     let raw = parallel(spec.values.len(), |k| {
         let value = spec.values[k];
         let result = compile(&[format!("{}={value}", spec.param)]).and_then(|c| {
-            crate::modes(&c, spec.frozen)
-                .map_err(|d| format!("{} {}", d.code.as_str(), d.message))
+            crate::modes(&c, spec.frozen).map_err(|d| format!("{} {}", d.code.as_str(), d.message))
         });
         let summary = match &result {
             Ok(m) => format!(
