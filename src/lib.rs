@@ -369,6 +369,44 @@ pub fn modes(c: &Compiled, frozen: bool) -> Result<solve::modes::Modes, Diagnost
     })
 }
 
+/// The unit of an output column as axes label it: `m`, `N`, `rad` for angles, `rad/s` for
+/// rates of turn, or `None` for a column the model does not write.
+pub fn channel_unit(c: &Compiled, column: &str) -> Option<String> {
+    use model::{BodyQuantity, JointKind, JointQuantity, Probe};
+    let o = c.model.outputs.iter().find(|o| o.column == column)?;
+    let turning = |q: &BodyQuantity| match q {
+        BodyQuantity::Crv => Some("rad"),
+        BodyQuantity::Rotation => Some("1"),
+        BodyQuantity::AngularVelocity => Some("rad/s"),
+        BodyQuantity::AngularAcceleration => Some("rad/s^2"),
+        _ => None,
+    };
+    let angular = match &o.probe {
+        Probe::Body { quantity, .. }
+        | Probe::Point { quantity, .. }
+        | Probe::CenterOfMass { quantity, .. } => turning(quantity),
+        Probe::Multiblade { .. } => Some("rad"),
+        Probe::Joint {
+            joint, quantity, ..
+        } => {
+            let revolute = !matches!(
+                c.model.joints.get(*joint).map(|j| &j.kind),
+                Some(JointKind::Prismatic { .. })
+            );
+            match quantity {
+                JointQuantity::Angle if revolute => Some("rad"),
+                JointQuantity::Rate if revolute => Some("rad/s"),
+                _ => None,
+            }
+        }
+        _ => None,
+    };
+    if let Some(u) = angular {
+        return Some(u.to_string());
+    }
+    model::channel_dim(&c.model.joints, &o.probe).map(|d| d.to_string())
+}
+
 /// A number with at most six significant digits, no trailing zeros: `31.4`, `0.001`.
 fn num6(x: f64) -> String {
     if x == 0.0 || !x.is_finite() {

@@ -102,6 +102,13 @@ enum Command {
         /// Chart title (default: the CSV's file name).
         #[arg(long)]
         title: Option<String>,
+        /// The model that wrote the CSV: channels are then grouped by unit, one panel each,
+        /// with their units on the axes.
+        #[arg(long, value_name = "MODEL.mbd")]
+        model: Option<String>,
+        /// With --model: override a param as the run did (NAME=VALUE).
+        #[arg(long = "set", value_name = "NAME=VALUE", requires = "model")]
+        set: Vec<String>,
     },
     /// Convergence or stability study: many runs of a model, one channel measured.
     #[command(long_about = study_cmd::LONG_ABOUT)]
@@ -184,7 +191,16 @@ fn main() -> ExitCode {
             channels,
             output,
             title,
-        } => plot(&csv, &channels, &output, title.as_deref()),
+            model,
+            set,
+        } => plot(
+            &csv,
+            &channels,
+            &output,
+            title.as_deref(),
+            model.as_deref(),
+            &set,
+        ),
         Command::Modes(args) => modes_cmd::modes(args),
         Command::Run {
             model,
@@ -251,8 +267,16 @@ fn main() -> ExitCode {
     }
 }
 
-/// `mbd plot`: exit 0, or 2 for an unreadable CSV, an unknown channel or an unwritable file.
-fn plot(path: &str, channels: &[String], output: &str, title: Option<&str>) -> ExitCode {
+/// `mbd plot`: exit 0, or 2 for an unreadable CSV, an unknown channel or an unwritable file
+/// (1 if `--model` has errors).
+fn plot(
+    path: &str,
+    channels: &[String],
+    output: &str,
+    title: Option<&str>,
+    model: Option<&str>,
+    sets: &[String],
+) -> ExitCode {
     let text = match std::fs::read_to_string(path) {
         Ok(t) => t,
         Err(e) => return usage(&format!("cannot read CSV file `{path}`: {e}")),
@@ -261,16 +285,35 @@ fn plot(path: &str, channels: &[String], output: &str, title: Option<&str>) -> E
         Ok(t) => t,
         Err(e) => return usage(&format!("`{path}` is not a CSV written by `mbd run`: {e}")),
     };
+    let compiled = match model {
+        None => None,
+        Some(m) => {
+            let source = match read(m) {
+                Ok(t) => t,
+                Err(code) => return code,
+            };
+            match compile(m, &source, sets, Overrides::default(), Format::Human) {
+                Ok(c) => Some(c),
+                Err(code) => return code,
+            }
+        }
+    };
     let name = std::path::Path::new(path)
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_else(|| path.to_string());
-    let chart =
-        match mbd::output::charts::time_history(title.unwrap_or(&name), &header, &rows, channels) {
-            Ok(c) => c,
-            Err(e) => return usage(&e),
-        };
-    let svg = match mbd::output::charts::render(&chart) {
+    let unit = |column: &str| compiled.as_ref().and_then(|c| mbd::channel_unit(c, column));
+    let charts = match mbd::output::charts::time_history(
+        title.unwrap_or(&name),
+        &header,
+        &rows,
+        channels,
+        &unit,
+    ) {
+        Ok(c) => c,
+        Err(e) => return usage(&e),
+    };
+    let svg = match mbd::output::charts::render_stack(&charts) {
         Ok(s) => s,
         Err(e) => return usage(&format!("cannot draw the chart: {e}")),
     };

@@ -322,3 +322,51 @@ fn plot_draws_the_named_channels_of_a_run() {
     );
     assert!(stderr(&o).contains("tension"), "{}", stderr(&o));
 }
+
+#[test]
+fn plot_with_the_model_puts_each_unit_on_its_own_axis() {
+    // Issue 16: a 3e-7 m channel and a 1e-3 rad channel shared one `value (SI)` axis.
+    let run_csv = temp("plot_windmill.csv", "");
+    let o = mbd(&[
+        "run",
+        "models/windmill.mbd",
+        "--until",
+        "0.05",
+        "-o",
+        run_csv.to_str().unwrap_or_default(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let svg = temp("plot_windmill.svg", "");
+    let args = |model: bool| {
+        let mut a = vec![
+            "plot".to_string(),
+            run_csv.to_string_lossy().to_string(),
+            "-o".to_string(),
+            svg.to_string_lossy().to_string(),
+        ];
+        for c in ["x_hub", "zeta1", "zeta2", "rotor_cm.x"] {
+            a.push("--channel".into());
+            a.push(c.into());
+        }
+        if model {
+            a.push("--model".into());
+            a.push("models/windmill.mbd".into());
+        }
+        a
+    };
+    let run = |model: bool| {
+        let a = args(model);
+        let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+        let o = mbd(&refs);
+        assert_eq!(code(&o), 0, "{}", stderr(&o));
+        std::fs::read_to_string(&svg).unwrap_or_default()
+    };
+    let grouped = run(true);
+    // Two panels: the lengths and the angles, each axis with its unit.
+    assert!(grouped.contains("x_hub, rotor_cm.x [m]"), "lengths");
+    assert!(grouped.contains("zeta1, zeta2 [rad]"), "angles");
+    assert_eq!(grouped.matches("t [s]").count(), 2);
+    // Without the model the CSV has no units: one axis, in SI, as before.
+    let plain = run(false);
+    assert!(plain.contains("value (SI)") && !plain.contains("[rad]"));
+}

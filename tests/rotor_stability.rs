@@ -186,6 +186,15 @@ fn the_stability_command_writes_its_csv_and_chart() {
         chart.to_str().expect("path"),
     ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
+    // Off a terminal, a line per finished evaluation (issue 16: 20-30 s of silence before).
+    let err = stderr(&o);
+    for v in [
+        "Omega_bar = 1 (floquet)",
+        "Omega_bar = 1 (prony)",
+        "Omega_bar = 1.5 (floquet)",
+    ] {
+        assert!(err.contains(v), "{v}: {err}");
+    }
     // The method column is text: split by hand.
     let text = std::fs::read_to_string(&out).expect("csv");
     let mut lines = text.lines();
@@ -246,6 +255,14 @@ fn the_stability_command_rejects_bad_requests_with_usage_errors() {
         (
             &["models/windmill_spinup.mbd", "--sweep", "T0=500:1000:500"],
             "--period",
+        ),
+        (
+            &[
+                "models/windmill.mbd",
+                "--sweep",
+                "omega_T=9rad/s:10m:1rad/s",
+            ],
+            "the range's STOP `10m`",
         ),
         (
             &[

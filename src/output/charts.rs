@@ -75,6 +75,41 @@ fn kept(p: &(f64, f64), log_x: bool, log_y: bool) -> bool {
 
 /// Renders a chart as an SVG document (800 x 500).
 pub fn render(chart: &Chart) -> Result<String, String> {
+    render_stack(std::slice::from_ref(chart))
+}
+
+/// Renders charts stacked vertically in one SVG document (800 wide, 500 for one chart, 300 per
+/// chart for several): panels of one figure, e.g. channels of different units over one time
+/// axis. The first chart's title is the figure's.
+pub fn render_stack(charts: &[Chart]) -> Result<String, String> {
+    if charts.is_empty() {
+        return Err("nothing to plot: no chart".to_string());
+    }
+    let height = if charts.len() == 1 {
+        500
+    } else {
+        60 + 280 * charts.len() as u32
+    };
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, height)).into_drawing_area();
+        let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
+        root.fill(&WHITE).map_err(e)?;
+        let areas = root.split_evenly((charts.len(), 1));
+        for (k, (chart, area)) in charts.iter().zip(&areas).enumerate() {
+            draw(area, chart, k == 0)?;
+        }
+        root.present().map_err(e)?;
+    }
+    Ok(svg)
+}
+
+/// Draws one chart on an area, with its title if `caption`.
+fn draw(
+    root: &DrawingArea<SVGBackend, plotters::coord::Shift>,
+    chart: &Chart,
+    caption: bool,
+) -> Result<(), String> {
     let (lx, ly) = (chart.log_x, chart.log_y);
     let pts = || {
         chart
@@ -85,14 +120,13 @@ pub fn render(chart: &Chart) -> Result<String, String> {
     };
     let (x0, x1) = range(pts().map(|p| p.0), lx).ok_or("nothing to plot: no finite points")?;
     let (y0, y1) = range(pts().map(|p| p.1), ly).ok_or("nothing to plot: no finite points")?;
-    let mut svg = String::new();
     {
-        let root = SVGBackend::with_string(&mut svg, (800, 500)).into_drawing_area();
         let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
-        root.fill(&WHITE).map_err(e)?;
-        let mut builder = ChartBuilder::on(&root);
+        let mut builder = ChartBuilder::on(root);
+        if caption {
+            builder.caption(&chart.title, ("sans-serif", 20));
+        }
         builder
-            .caption(&chart.title, ("sans-serif", 20))
             .margin(12)
             .x_label_area_size(42)
             .y_label_area_size(72);
@@ -164,23 +198,26 @@ pub fn render(chart: &Chart) -> Result<String, String> {
             (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
             (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
         }
-        root.present().map_err(e)?;
     }
-    Ok(svg)
+    Ok(())
 }
 
-/// Time histories of the named channels of a run's CSV (header `t`, then channels).
+/// Time histories of the named channels of a run's CSV (header `t`, then channels): one panel
+/// per unit, `unit(channel)` giving it (`m`, `rad`, `N`); channels without a known unit share
+/// one panel labelled in SI.
 pub fn time_history(
     title: &str,
     header: &[String],
     rows: &[Vec<f64>],
     channels: &[String],
-) -> Result<Chart, String> {
+    unit: &dyn Fn(&str) -> Option<String>,
+) -> Result<Vec<Chart>, String> {
     let t = header
         .iter()
         .position(|h| h == "t")
         .ok_or("the CSV has no `t` column")?;
-    let mut series = Vec::new();
+    // Panels in the order their first channel was asked for.
+    let mut panels: Vec<(Option<String>, Vec<Series>)> = Vec::new();
     for name in channels {
         let Some(k) = header.iter().position(|h| h == name) else {
             let known: Vec<&str> = header
@@ -193,25 +230,38 @@ pub fn time_history(
                 known.join(", ")
             ));
         };
-        series.push(Series {
+        let series = Series {
             label: name.clone(),
             points: rows.iter().map(|r| (r[t], r[k])).collect(),
             markers_only: false,
-        });
+        };
+        let u = unit(name);
+        match panels.iter_mut().find(|(pu, _)| *pu == u) {
+            Some((_, list)) => list.push(series),
+            None => panels.push((u, vec![series])),
+        }
     }
-    Ok(Chart {
-        title: title.to_string(),
-        x_label: "t [s]".to_string(),
-        y_label: if channels.len() == 1 {
-            channels[0].clone()
-        } else {
-            "value (SI)".to_string()
-        },
-        log_x: false,
-        log_y: false,
-        series,
-        shaded: Vec::new(),
-    })
+    Ok(panels
+        .into_iter()
+        .map(|(u, series)| {
+            let names: Vec<&str> = series.iter().map(|s| s.label.as_str()).collect();
+            let y_label = match (&u, names.len()) {
+                (Some(u), n) if n <= 3 => format!("{} [{u}]", names.join(", ")),
+                (Some(u), _) => format!("[{u}]"),
+                (None, 1) => names[0].to_string(),
+                (None, _) => "value (SI)".to_string(),
+            };
+            Chart {
+                title: title.to_string(),
+                x_label: "t [s]".to_string(),
+                y_label,
+                log_x: false,
+                log_y: false,
+                series,
+                shaded: Vec::new(),
+            }
+        })
+        .collect())
 }
 
 #[cfg(test)]
