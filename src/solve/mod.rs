@@ -14,6 +14,7 @@ mod newton;
 mod rotations;
 mod se3;
 mod start;
+mod steady;
 
 pub use integrator::Integrator;
 
