@@ -616,9 +616,9 @@ impl<'a> Elaborator<'a> {
             let Some(ty) = ParamType::parse(&p.ty.name) else {
                 continue;
             };
-            let (expr, eval_scope) = match (given.get(p.name.name.as_str()), &p.default) {
-                (Some(a), _) => (a.value.clone(), scope),
-                (None, Some(d)) => (d.clone(), inst),
+            let (expr, offset, eval_scope) = match (given.get(p.name.name.as_str()), &p.default) {
+                (Some(a), _) => (a.value.clone(), a.offset.clone(), scope),
+                (None, Some(d)) => (d.clone(), None, inst),
                 (None, None) => {
                     self.error(
                         scope,
@@ -655,6 +655,27 @@ impl<'a> Elaborator<'a> {
                 );
                 continue;
             }
+            if let (Some(o), false) = (&offset, ty == ParamType::Marker) {
+                self.error(
+                    scope,
+                    Diagnostic::error(
+                        Code::E0215,
+                        format!(
+                            "argument `{}` of `{}` is a {}: it takes no offset",
+                            p.name.name,
+                            def.name.name,
+                            ty.name()
+                        ),
+                    )
+                    .at(o.span, "an offset")
+                    .at(p.ty.span, "declared here")
+                    .hint(format!(
+                        "only `marker` arguments take `@ (x, y, z)`; {}",
+                        ty.example()
+                    )),
+                );
+                continue;
+            }
             let mut b = Env::binding(
                 &p.name,
                 p.span,
@@ -665,6 +686,7 @@ impl<'a> Elaborator<'a> {
                 None,
             );
             b.component = Some(def.name.name.clone());
+            b.offset = offset;
             // Arguments are part of a component's interface: never reported unused.
             b.used = true;
             let id = self.env.add_binding(b);

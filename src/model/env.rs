@@ -23,6 +23,8 @@ use std::rc::Rc;
 pub type ScopeId = usize;
 pub type DeclId = usize;
 pub type BindingId = usize;
+/// The offset of a marker argument and the scope it is evaluated in.
+pub type Offset = (Expr, ScopeId);
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Member {
@@ -87,6 +89,9 @@ pub struct Binding {
     pub ty: Option<(ParamType, Span)>,
     /// For a component argument: the component it belongs to (for messages).
     pub component: Option<String>,
+    /// For a marker argument written with an offset (`base = earth @ (0, 0, 1) m`): the
+    /// offset, evaluated in `scope` when the marker is resolved.
+    pub offset: Option<Expr>,
     state: State,
     pub used: bool,
 }
@@ -174,6 +179,9 @@ pub struct Env {
     /// Set by [`Env::resolve_family`]: a family named without an index resolves to
     /// [`Ref::Family`] instead of asking for an index.
     families: bool,
+    /// Set by [`Env::resolve_marker`]: the offsets of the marker arguments resolution passes
+    /// through, each with the scope it is evaluated in.
+    offsets: Option<Vec<Offset>>,
 }
 
 impl Env {
@@ -307,6 +315,7 @@ impl Env {
             set: None,
             ty,
             component: None,
+            offset: None,
             state: match value {
                 Some(v) => State::Done(v),
                 None => State::Pending,
@@ -498,6 +507,14 @@ impl Env {
 
     /// Evaluates the index and argument expressions of a path in `scope`.
     pub fn segs(&mut self, scope: ScopeId, path: &Path) -> Result<Vec<Seg>, Diagnostic> {
+        // Index and argument values are not markers: their paths collect no offsets.
+        let was = self.offsets.take();
+        let r = self.segs_inner(scope, path);
+        self.offsets = was;
+        r
+    }
+
+    fn segs_inner(&mut self, scope: ScopeId, path: &Path) -> Result<Vec<Seg>, Diagnostic> {
         let mut out = Vec::with_capacity(path.segments.len());
         for s in &path.segments {
             let index = match &s.index {
@@ -552,6 +569,21 @@ impl Env {
         let r = self.resolve(scope, segs, span);
         self.families = was;
         r
+    }
+
+    /// Like [`Env::resolve`], for a marker: also returns the offsets of the marker arguments
+    /// it passes through (`hub = earth @ (0, 0, 1) m` named as `hub`), each to be evaluated in
+    /// its scope and added to the marker's own offset.
+    pub fn resolve_marker(
+        &mut self,
+        scope: ScopeId,
+        segs: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>, Vec<Offset>), Diagnostic> {
+        let was = self.offsets.replace(Vec::new());
+        let r = self.resolve(scope, segs, span);
+        let offsets = std::mem::replace(&mut self.offsets, was).unwrap_or_default();
+        r.map(|(r, rest)| (r, rest, offsets))
     }
 
     fn resolve_inner(
@@ -623,6 +655,28 @@ impl Env {
                     else {
                         return Err(secondary(span));
                     };
+                    if let Some(offset) = self.bindings[b].offset.clone() {
+                        let shown = format!("{} @ ...", path.text());
+                        if let Some(next) = rest.first() {
+                            return Err(Diagnostic::error(
+                                Code::E0222,
+                                format!("`{name}` is the point `{shown}`: it has no `{}`", next.name.name),
+                            )
+                            .at(next.span, "after a point with an offset")
+                            .hint("a marker passed with an offset (`@`) has no markers or quantities of its own: use it where a marker goes (a joint, a spring, a load), or pass the marker without the offset"));
+                        }
+                        match self.offsets.as_mut() {
+                            Some(list) => list.push((offset, bscope)),
+                            None => {
+                                return Err(Diagnostic::error(
+                                    Code::E0222,
+                                    format!("`{name}` is the point `{shown}`, usable only as a marker"),
+                                )
+                                .at(span, "not used as a marker")
+                                .hint("a marker argument with an offset goes where a marker goes (a joint, a spring, a load); pass it without `@` to use it here"))
+                            }
+                        }
+                    }
                     let mut segs = self.segs(bscope, &path)?;
                     segs.extend_from_slice(rest);
                     return self.resolve(bscope, &segs, span);

@@ -362,8 +362,25 @@ impl Cx {
                     .map(|q| {
                         let mut jt = q.into_inner();
                         let name = self.ident(take(&mut jt, "argument name")?);
-                        let value = self.expr(take(&mut jt, "argument value")?)?;
-                        Ok(Arg { name, value })
+                        let v = take(&mut jt, "argument value")?;
+                        if v.as_rule() == Rule::marker {
+                            let m = self.marker(v)?;
+                            let value = Expr {
+                                span: m.path.span,
+                                kind: ExprKind::Path { path: m.path },
+                            };
+                            return Ok(Arg {
+                                name,
+                                value,
+                                offset: m.offset,
+                            });
+                        }
+                        let value = self.expr(v)?;
+                        Ok(Arg {
+                            name,
+                            value,
+                            offset: None,
+                        })
                     })
                     .collect::<Parsed<_>>()?;
                 Item::Instance {
