@@ -48,6 +48,7 @@ const CASES: &[(&str, Code)] = &[
     ("multiblade_one_blade", Code::E0226),
     ("multiblade_azimuth", Code::E0227),
     ("center_of_mass_massless", Code::E0228),
+    ("missing_solve", Code::E0229),
     ("output_call_component", Code::E0212),
     ("redundant_constraints", Code::E0307),
     ("massless_motion", Code::E0308),

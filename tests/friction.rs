@@ -120,3 +120,29 @@ solve hht { dt = 0.01 s, until = 0.1 s }
         d[1].message
     );
 }
+
+#[test]
+fn a_missing_solve_block_is_named_at_the_model_header() {
+    let text = "model pendulum \"no solve block\"
+ground earth
+point_mass bob { mass = 1 kg, at = (0, -1, 0) m }
+joint link = distance(earth, bob)
+";
+    let d = errors(text);
+    assert_eq!(codes(&d), vec![Code::E0229]);
+    assert_eq!(d[0].message, "the model has no `solve` block");
+    assert_eq!(spanned(text, &d[0], 0), "model pendulum \"no solve block\"");
+    assert_eq!(d[0].labels[0].text, "this model has no `solve` block");
+    assert!(d[0].hint.as_deref().unwrap_or("").contains("solve hht {"));
+    // Without a header, at the start of the file, next to E0103.
+    let d = errors(&text.replace("model pendulum \"no solve block\"\n", ""));
+    assert_eq!(codes(&d), vec![Code::E0103, Code::E0229]);
+    assert_eq!(d[1].labels[0].span.start, 0);
+    // The command line may stand in for the block.
+    let o = Overrides {
+        until: Some(0.1),
+        dt: Some(0.01),
+        ..Default::default()
+    };
+    assert!(mbd::compile("p.mbd", text, &[], o).is_ok());
+}

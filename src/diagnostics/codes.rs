@@ -152,6 +152,11 @@ is taken at psi + 2 pi k / N, so blade 0 must be the one at psi = 0.";
 declared in it, recursively, with the concentrated masses they carry) or a family of them. \
 What it names is none of these (a joint, a param, a quantity), declares no bodies, or has no \
 mass at all (a massless hub), so it has no centre of mass.";
+    E0229 = "E0229", "model has no solve block",
+        "The model file has no `solve` block, so nothing says how to integrate it or for how \
+long. Add one at the top level: `solve hht { dt = 1 ms, until = 1 s }` (the method, the time \
+step or the number of steps, and the end time; section 13 of docs/language.md lists the \
+settings). Without a block, `mbd run` needs both `--until` and `--dt` (or `--steps`).";
     E0301 = "E0301", "joint connects a body to itself",
         "Both markers of a joint are on the same body, so the joint constrains nothing. Connect it \
 to another body or to ground.";

@@ -172,7 +172,15 @@ pub fn build(
     }
     let outputs = b.outputs(&out.outputs);
     let exact = b.exacts(&out.exacts, &outputs);
-    let solve = b.solve(out.solve.as_ref(), overrides, top, file.span);
+    // A missing solve block is reported at the header (or where it belongs).
+    let header = match &out.header {
+        Some((_, _, span)) => *span,
+        None => Span {
+            end: file.span.start,
+            ..file.span
+        },
+    };
+    let solve = b.solve(out.solve.as_ref(), overrides, top, file.span, header);
 
     for e in std::mem::take(&mut b.env.errors) {
         b.sink.push(e);
