@@ -32,6 +32,7 @@ const CASES: &[(&str, Code)] = &[
     ("marker_offset_on_point_mass", Code::E0306),
     ("unused_param", Code::W0201),
     ("several_errors", Code::E0202),
+    ("repeated_in_loop", Code::E0202),
     ("index_out_of_range", Code::E0214),
     ("component_argument", Code::E0215),
     ("module_not_found", Code::E0216),

@@ -146,3 +146,119 @@ joint link = distance(earth, bob)
     };
     assert!(mbd::compile("p.mbd", text, &[], o).is_ok());
 }
+
+#[test]
+fn a_failed_argument_is_one_error_not_three() {
+    // Issue 16's model: `h` is a bare number where the rod's length is needed. The rod is not
+    // built, so neither the initial spin nor the centre of mass finds a body; both stay silent.
+    let text = "model m
+use stdlib::rod::hinged_rod
+param h = 1.5
+ground earth
+arm = hinged_rod(base = earth, root = (0,0,0) m, direction = x, length = h, mass = 1 kg)
+initial spin of arm = 1 rad/s about z
+initial spin of arm.bar = 1 rad/s about z
+output cm = center_of_mass(arm), tip = arm.end.position
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let d = errors(text);
+    assert_eq!(codes(&d), vec![Code::E0215], "{d:#?}");
+    assert_eq!(spanned(text, &d[0], 0), "h");
+    // An unknown component: the names through the instance are not unknown too.
+    let text = "model m
+param Omega = 3 rad/s
+ground earth
+rotor = lag_hinged_rotr(hub = earth, speed = Omega)
+initial spin of rotor = Omega about z
+output r = rotor.drive.rate, cm = center_of_mass(rotor)
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let d = errors(text);
+    assert_eq!(codes(&d), vec![Code::E0201], "{d:#?}");
+    assert_eq!(spanned(text, &d[0], 0), "lag_hinged_rotr");
+}
+
+#[test]
+fn a_mistake_in_a_loop_is_reported_once_with_the_iterations_that_hit_it() {
+    let text = "model m
+ground earth
+for i in 0..3 {
+    point_mass bob[i] { mass = 1 m, at = (i, -1, 0) m }
+    joint link[i] = distance(earth, bob[i + 1])
+    if i {
+        force push[i] on bob[i] = (1, 0, 0) kg
+    }
+}
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let d = errors(text);
+    assert_eq!(
+        codes(&d),
+        vec![Code::E0202, Code::E0202, Code::E0214],
+        "{d:#?}"
+    );
+    let label = |d: &Diagnostic| {
+        let l = d.labels.last().map(|l| l.span).unwrap_or(d.labels[0].span);
+        (
+            &text[l.start as usize..l.end as usize],
+            d.labels.last().map(|l| l.text.clone()).unwrap_or_default(),
+        )
+    };
+    // Every iteration: the mass (the message names no member: `bob[..]`).
+    assert_eq!(spanned(text, &d[0], 0), "1 m");
+    assert_eq!(
+        label(&d[0]),
+        (
+            "for i in 0..3",
+            "in all 3 iterations of this loop".to_string()
+        )
+    );
+    // Two of three: the force.
+    assert_eq!(spanned(text, &d[1], 0), "(1, 0, 0) kg");
+    assert_eq!(
+        label(&d[1]).1,
+        "in 2 of the 3 iterations of this loop (`i` = 1, 2)"
+    );
+    // The last only: the index past the end.
+    assert_eq!(spanned(text, &d[2], 0), "i + 1");
+    assert_eq!(label(&d[2]).1, "in the iteration `i = 2` of this loop");
+    assert_eq!(d[2].message, "index 3 is out of range for `bob`");
+}
+
+#[test]
+fn indices_that_differ_between_iterations_read_as_a_family() {
+    let text = "model m
+ground earth
+for i in 0..2 {
+    point_mass bob[i] { mass = -1 kg, at = (i, -1, 0) m }
+}
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let d = errors(text);
+    assert_eq!(codes(&d), vec![Code::E0302]);
+    assert_eq!(d[0].message, "the mass of `bob[..]` is not positive");
+}
+
+#[test]
+fn a_param_whose_only_user_failed_is_not_reported_unused() {
+    let text = "model m
+param k = 10 N*m/rad
+param c = 1 N*m*s/rad
+ground earth
+rigid_rod bar { from = (0, 0, 0) m, to = (1, 0, 0) m, mass = 1 kg }
+joint hinge = revolute(earth, bar.strat) { axis = z, spring = k }
+for i in 0..2 {
+    joint j[i] = revolute(earth, bar.stat) { axis = z, damper = c }
+}
+param unused = 2
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let d = errors(text);
+    // `k` and `c` were given to joints whose markers failed; `unused` really is unused.
+    assert_eq!(
+        codes(&d),
+        vec![Code::E0201, Code::E0201, Code::W0201],
+        "{d:#?}"
+    );
+    assert!(d[2].message.contains("`unused`"), "{}", d[2].message);
+}

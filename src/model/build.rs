@@ -7,7 +7,7 @@ use super::env::{is_secondary, BindingKind, Env, Named, ScopeId};
 use super::eval::Value;
 use super::units::Dim;
 use super::*;
-use crate::diagnostics::{did_you_mean, Code, Diagnostic, Sink};
+use crate::diagnostics::{did_you_mean, merge_repeats, Code, Diagnostic, Sink};
 use crate::source::SourceMap;
 use crate::syntax::ast::{self, Block, Expr, Item, MarkerRef, Prop, PropValue};
 use std::collections::HashMap;
@@ -73,8 +73,22 @@ pub(super) const KINDS: &[&str] = &[
     "concentrated_mass",
 ];
 
-/// Builds and checks the model. Every error found is pushed to `sink`; `None` if any.
+/// Builds and checks the model. Every error found is pushed to `sink`, each mistake once (a
+/// loop's repeats merged, see [`merge_repeats`]); `None` if any.
 pub fn build(
+    file: &ast::File,
+    file_name: &str,
+    overrides: &Overrides,
+    sources: &mut SourceMap,
+    loader: &dyn Loader,
+    sink: &mut Sink,
+) -> Option<Model> {
+    let model = build_model(file, file_name, overrides, sources, loader, sink);
+    sink.diagnostics = merge_repeats(std::mem::take(&mut sink.diagnostics));
+    model
+}
+
+fn build_model(
     file: &ast::File,
     file_name: &str,
     overrides: &Overrides,
@@ -196,6 +210,7 @@ pub fn build(
     for e in std::mem::take(&mut b.env.errors) {
         b.sink.push(e);
     }
+    b.excuse_failed(&file.items, file.span.source);
     b.unused(file.span.source, &out);
     if b.sink.has_errors() {
         return None;
@@ -328,6 +343,19 @@ impl Builder<'_> {
             }
         };
         self.built[v.decl] = built;
+    }
+
+    /// Whether a body or beam named `name`, or declared inside the instance named `name`
+    /// (`rotor`), failed to build. What needs those bodies stays silent then: their own errors
+    /// have been reported, and "declares no bodies" would be a second error for one mistake.
+    pub fn failed_within(&self, name: &str) -> bool {
+        self.env.decls.iter().enumerate().any(|(d, decl)| {
+            self.built[d].is_none()
+                && decl
+                    .item_kind()
+                    .is_some_and(|k| matches!(k, "point_mass" | "rigid" | "rigid_rod" | "beam"))
+                && (decl.name == name || decl.name.starts_with(&format!("{name}.")))
+        })
     }
 
     /// Checks the parts a declaration has against those its kind takes.
@@ -662,6 +690,30 @@ impl Builder<'_> {
         Some(x as usize)
     }
 
+    /// Marks as used every name written in a declaration of the model file that failed (the
+    /// innermost item holding a label of an error): a param whose only user failed was not
+    /// forgotten, and "never used" would be a second report of one mistake.
+    fn excuse_failed(&mut self, items: &[Item], main: crate::source::SourceId) {
+        let spans: Vec<Span> = self
+            .sink
+            .diagnostics
+            .iter()
+            .filter(|d| d.is_error())
+            .flat_map(|d| d.labels.iter().map(|l| l.span))
+            .filter(|s| s.source == main)
+            .collect();
+        if spans.is_empty() {
+            return;
+        }
+        let mut names = std::collections::HashSet::new();
+        failed_names(items, &spans, &mut names);
+        for b in &mut self.env.bindings {
+            if b.span.source == main && names.contains(&b.name) {
+                b.used = true;
+            }
+        }
+    }
+
     /// Warnings for what the model file declares and never uses.
     fn unused(&mut self, main: crate::source::SourceId, out: &super::elaborate::Elaborated) {
         let mut warnings = Vec::new();
@@ -726,6 +778,50 @@ impl Builder<'_> {
             self.sink.push(w);
         }
     }
+}
+
+/// Collects the names written in the innermost items that contain one of `spans`; whether
+/// any item did.
+fn failed_names(
+    items: &[Item],
+    spans: &[Span],
+    names: &mut std::collections::HashSet<String>,
+) -> bool {
+    let mut any = false;
+    for item in items {
+        let outer = item.span();
+        if !spans
+            .iter()
+            .any(|s| outer.start <= s.start && s.end <= outer.end)
+        {
+            continue;
+        }
+        any = true;
+        let inside = match item {
+            Item::For { items, .. } => failed_names(items, spans, names),
+            Item::If {
+                then, otherwise, ..
+            } => failed_names(then, spans, names) | failed_names(otherwise, spans, names),
+            Item::Component(c) => failed_names(&c.items, spans, names),
+            _ => false,
+        };
+        if !inside {
+            names.extend(written_names(item));
+        }
+    }
+    any
+}
+
+/// Every name an item writes (declared or used), read from its syntax tree.
+pub(super) fn written_names(item: &Item) -> Vec<String> {
+    let Ok(text) = serde_json::to_string(item) else {
+        return Vec::new();
+    };
+    text.split("\"name\":\"")
+        .skip(1)
+        .filter_map(|part| part.split('"').next())
+        .map(str::to_string)
+        .collect()
 }
 
 pub(super) fn unit_hint(dim: Dim) -> String {

@@ -540,6 +540,12 @@ impl Builder<'_> {
             {
                 self.env.decls[d].name.clone()
             }
+            // A body that failed to build: its error has been reported.
+            Ok((Ref::Decl(d), rest))
+                if rest.is_empty() && self.failed_within(&self.env.decls[d].name) =>
+            {
+                return
+            }
             Ok(_) => {
                 return self.error(
                     scope,
@@ -618,7 +624,7 @@ impl Builder<'_> {
                 moved += 1;
             }
         }
-        if moved == 0 {
+        if moved == 0 && !self.failed_within(prefix.trim_end_matches('.')) {
             self.error(
                 scope,
                 Diagnostic::error(Code::E0222, "this initial motion moves no body")

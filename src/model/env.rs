@@ -1,4 +1,4 @@
-//! Scopes, bindings and name resolution.
+//! Scopes, bindings and their evaluation; paths are resolved in `resolve.rs`.
 //!
 //! A scope holds names: value bindings (params, lets, functions, component arguments, loop
 //! variables), declarations, indexed families of them (`blade[0..4]`), component instances and
@@ -13,10 +13,10 @@
 use super::eval::{eval, Names, Value};
 use super::types::ParamType;
 use super::units::Dim;
-use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::diagnostics::{Code, Diagnostic, Iteration};
 use crate::runtime::timefn::TimeFn;
 use crate::source::Span;
-use crate::syntax::ast::{Component, Expr, ExprKind, Ident, Item, Path, PropValue};
+use crate::syntax::ast::{Component, Expr, Ident, Item, Path, PropValue};
 use std::collections::{BTreeMap, HashMap};
 use std::rc::Rc;
 
@@ -58,6 +58,11 @@ pub struct Scope {
     pub instance: Option<(String, Span)>,
     /// For an instance scope: the scope of the code that instantiated it.
     pub caller: Option<ScopeId>,
+    /// For the scope of one iteration of a `for` loop: which one.
+    pub iteration: Option<Iteration>,
+    /// For an instance scope: the instance could not be made (unknown component, too deep), so
+    /// what names it stays silent; the cause has been reported.
+    pub failed: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -143,7 +148,7 @@ pub enum Ref {
 
 const BUILTINS: &[&str] = &["t", "pi", "x", "y", "z", "true", "false"];
 
-fn builtin(name: &str) -> Option<Value> {
+pub(super) fn builtin(name: &str) -> Option<Value> {
     let unit = |k: usize| {
         let mut v = [0.0; 3];
         v[k] = 1.0;
@@ -175,13 +180,13 @@ pub struct Env {
     /// Errors found while evaluating on demand.
     pub errors: Vec<Diagnostic>,
     /// Nesting of on-demand evaluations, to stop runaway self-reference.
-    depth: usize,
+    pub(super) depth: usize,
     /// Set by [`Env::resolve_family`]: a family named without an index resolves to
     /// [`Ref::Family`] instead of asking for an index.
-    families: bool,
+    pub(super) families: bool,
     /// Set by [`Env::resolve_marker`]: the offsets of the marker arguments resolution passes
     /// through, each with the scope it is evaluated in.
-    offsets: Option<Vec<Offset>>,
+    pub(super) offsets: Option<Vec<Offset>>,
 }
 
 impl Env {
@@ -201,6 +206,8 @@ impl Env {
             exports: None,
             instance: None,
             caller: None,
+            iteration: None,
+            failed: false,
         });
         id
     }
@@ -356,11 +363,15 @@ impl Env {
         }
     }
 
-    /// "in this instance of component X" notes for a diagnostic raised in `scope`.
+    /// "in this instance of component X" notes for a diagnostic raised in `scope`, and the loop
+    /// iterations it was raised in (labels once repeats are merged).
     pub fn trace(&self, scope: ScopeId, mut d: Diagnostic) -> Diagnostic {
         let mut s = Some(scope);
         let mut n = 0;
         while let Some(id) = s {
+            if let Some(it) = &self.scopes[id].iteration {
+                d.iterations.push(it.clone());
+            }
             if let Some((comp, span)) = &self.scopes[id].instance {
                 if n < 4 && !d.labels.iter().any(|l| l.span == *span) {
                     d = d.at(*span, format!("in this instance of component `{comp}`"));
@@ -503,327 +514,6 @@ impl Env {
             }
         }
         Ok(v)
-    }
-
-    /// Evaluates the index and argument expressions of a path in `scope`.
-    pub fn segs(&mut self, scope: ScopeId, path: &Path) -> Result<Vec<Seg>, Diagnostic> {
-        // Index and argument values are not markers: their paths collect no offsets.
-        let was = self.offsets.take();
-        let r = self.segs_inner(scope, path);
-        self.offsets = was;
-        r
-    }
-
-    fn segs_inner(&mut self, scope: ScopeId, path: &Path) -> Result<Vec<Seg>, Diagnostic> {
-        let mut out = Vec::with_capacity(path.segments.len());
-        for s in &path.segments {
-            let index = match &s.index {
-                Some(e) => Some((self.integer_in(scope, e, "an index")?, e.span)),
-                None => None,
-            };
-            let arg = match &s.arg {
-                Some(e) => Some((self.eval_in(scope, e)?, e.span)),
-                None => None,
-            };
-            out.push(Seg {
-                name: s.name.clone(),
-                index,
-                arg,
-                span: s.span,
-            });
-        }
-        Ok(out)
-    }
-
-    /// Resolves a path to what it names, returning the segments left over (a property, a
-    /// marker, a quantity). Follows component arguments of reference type and export aliases.
-    pub fn resolve(
-        &mut self,
-        scope: ScopeId,
-        segs: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        self.depth += 1;
-        if self.depth > 64 {
-            self.depth -= 1;
-            return Err(
-                Diagnostic::error(Code::E0207, "this reference refers back to itself")
-                    .at(span, "resolving this never ends")
-                    .hint("an argument or export alias names itself, directly or through others"),
-            );
-        }
-        let r = self.resolve_inner(scope, segs, span);
-        self.depth -= 1;
-        r
-    }
-
-    /// Like [`Env::resolve`], but a family named without an index (`rotor.lag`) is a
-    /// [`Ref::Family`], for output functions that take every member.
-    pub fn resolve_family(
-        &mut self,
-        scope: ScopeId,
-        segs: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let was = std::mem::replace(&mut self.families, true);
-        let r = self.resolve(scope, segs, span);
-        self.families = was;
-        r
-    }
-
-    /// Like [`Env::resolve`], for a marker: also returns the offsets of the marker arguments
-    /// it passes through (`hub = earth @ (0, 0, 1) m` named as `hub`), each to be evaluated in
-    /// its scope and added to the marker's own offset.
-    pub fn resolve_marker(
-        &mut self,
-        scope: ScopeId,
-        segs: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>, Vec<Offset>), Diagnostic> {
-        let was = self.offsets.replace(Vec::new());
-        let r = self.resolve(scope, segs, span);
-        let offsets = std::mem::replace(&mut self.offsets, was).unwrap_or_default();
-        r.map(|(r, rest)| (r, rest, offsets))
-    }
-
-    fn resolve_inner(
-        &mut self,
-        scope: ScopeId,
-        segs: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let Some(head) = segs.first() else {
-            return Err(Diagnostic::error(Code::E0201, "empty path").at(span, "here"));
-        };
-        let named = match self.lookup(scope, &head.name.name) {
-            Some(n) => n,
-            None => {
-                if let (Some(v), None) = (builtin(&head.name.name), head.index) {
-                    return Ok((Ref::Builtin(v), segs[1..].to_vec()));
-                }
-                let candidates = self.visible(scope);
-                let d =
-                    Diagnostic::error(Code::E0201, format!("unknown name `{}`", head.name.name))
-                        .at(head.name.span, "not declared");
-                return Err(match did_you_mean(&head.name.name, candidates.iter().map(|s| s.as_str())) {
-                    Some(s) => d.hint(format!("did you mean `{s}`?")),
-                    None => d.hint("declare it (`param`, `let`, a body, a joint, ...) or import it with `use`; names are case-sensitive"),
-                });
-            }
-        };
-        self.follow(named, head, &segs[1..], span)
-    }
-
-    /// Continues resolution from `named` (reached by segment `seg`) with the segments `rest`.
-    fn follow(
-        &mut self,
-        named: Named,
-        seg: &Seg,
-        rest: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let name = &seg.name.name;
-        let not_indexed = |what: &str| {
-            Diagnostic::error(
-                Code::E0214,
-                format!("`{name}` is {what}, not an indexed family"),
-            )
-            .at(
-                seg.index.map(|i| i.1).unwrap_or(seg.span),
-                "index given here",
-            )
-            .hint(format!("write `{name}` without an index"))
-        };
-        let r = match named {
-            Named::Binding(b) => {
-                if seg.index.is_some() {
-                    return Err(not_indexed("a value"));
-                }
-                let is_ref = self.bindings[b]
-                    .ty
-                    .as_ref()
-                    .map(|t| t.0.is_reference())
-                    .unwrap_or(false);
-                if is_ref {
-                    // A marker or body argument: resolve what the caller wrote, in the caller's scope.
-                    self.bindings[b].used = true;
-                    let (expr, bscope) = (self.bindings[b].expr.clone(), self.bindings[b].scope);
-                    let Some(Expr {
-                        kind: ExprKind::Path { path },
-                        ..
-                    }) = expr
-                    else {
-                        return Err(secondary(span));
-                    };
-                    if let Some(offset) = self.bindings[b].offset.clone() {
-                        let shown = format!("{} @ ...", path.text());
-                        if let Some(next) = rest.first() {
-                            return Err(Diagnostic::error(
-                                Code::E0222,
-                                format!("`{name}` is the point `{shown}`: it has no `{}`", next.name.name),
-                            )
-                            .at(next.span, "after a point with an offset")
-                            .hint("a marker passed with an offset (`@`) has no markers or quantities of its own: use it where a marker goes (a joint, a spring, a load), or pass the marker without the offset"));
-                        }
-                        match self.offsets.as_mut() {
-                            Some(list) => list.push((offset, bscope)),
-                            None => {
-                                return Err(Diagnostic::error(
-                                    Code::E0222,
-                                    format!("`{name}` is the point `{shown}`, usable only as a marker"),
-                                )
-                                .at(span, "not used as a marker")
-                                .hint("a marker argument with an offset goes where a marker goes (a joint, a spring, a load); pass it without `@` to use it here"))
-                            }
-                        }
-                    }
-                    let mut segs = self.segs(bscope, &path)?;
-                    segs.extend_from_slice(rest);
-                    return self.resolve(bscope, &segs, span);
-                }
-                Ref::Binding(b)
-            }
-            Named::Decl(d) => {
-                if seg.index.is_some() {
-                    return Err(not_indexed("a single declaration"));
-                }
-                self.decls[d].used = true;
-                Ref::Decl(d)
-            }
-            Named::Component(c, _) => Ref::Component(c),
-            Named::Instance(s) => {
-                if seg.index.is_some() {
-                    return Err(not_indexed("a single instance"));
-                }
-                return self.enter_instance(s, rest, span);
-            }
-            Named::Family(map) => {
-                if seg.index.is_none() && self.families {
-                    for m in map.values() {
-                        if let Member::Decl(d) = m {
-                            self.decls[*d].used = true;
-                        }
-                    }
-                    return Ok((Ref::Family(map.into_iter().collect()), rest.to_vec()));
-                }
-                let Some((i, ispan)) = seg.index else {
-                    let (lo, hi) = (
-                        map.keys().next().copied().unwrap_or(0),
-                        map.keys().last().copied().unwrap_or(0),
-                    );
-                    return Err(Diagnostic::error(
-                        Code::E0214,
-                        format!("`{name}` is an indexed family; say which one"),
-                    )
-                    .at(seg.span, "no index")
-                    .hint(format!("write `{name}[i]` with i in {lo}..={hi}")));
-                };
-                match map.get(&i) {
-                    Some(Member::Decl(d)) => {
-                        self.decls[*d].used = true;
-                        Ref::Decl(*d)
-                    }
-                    Some(Member::Instance(s)) => return self.enter_instance(*s, rest, span),
-                    None => {
-                        let keys: Vec<i64> = map.keys().copied().collect();
-                        let range = match (keys.first(), keys.last()) {
-                            (Some(a), Some(b)) if (b - a + 1) as usize == keys.len() => {
-                                format!("{a}..={b}")
-                            }
-                            _ => keys
-                                .iter()
-                                .map(|k| k.to_string())
-                                .collect::<Vec<_>>()
-                                .join(", "),
-                        };
-                        return Err(Diagnostic::error(
-                            Code::E0214,
-                            format!("index {i} is out of range for `{name}`"),
-                        )
-                        .at(ispan, "no such member")
-                        .hint(format!("`{name}` has indices {range}")));
-                    }
-                }
-            }
-        };
-        Ok((r, rest.to_vec()))
-    }
-
-    /// Resolves the segments after an instance name, honouring its exports.
-    fn enter_instance(
-        &mut self,
-        s: ScopeId,
-        rest: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let Some(next) = rest.first() else {
-            return Ok((Ref::Instance(s), Vec::new()));
-        };
-        let key = next.name.name.clone();
-        if let Some(exports) = &self.scopes[s].exports {
-            match exports.get(&key) {
-                None => {
-                    let comp = self.scopes[s]
-                        .instance
-                        .clone()
-                        .map(|i| i.0)
-                        .unwrap_or_default();
-                    let mut names: Vec<&String> = exports.keys().collect();
-                    names.sort();
-                    let list = names
-                        .iter()
-                        .map(|n| n.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ");
-                    let code = if self.scopes[s].names.contains_key(&key) {
-                        Code::E0219
-                    } else {
-                        Code::E0201
-                    };
-                    let d = Diagnostic::error(
-                        code,
-                        format!("component `{comp}` does not export `{key}`"),
-                    )
-                    .at(next.name.span, "not exported");
-                    return Err(match did_you_mean(&key, names.iter().map(|n| n.as_str())) {
-                        Some(m) => d.hint(format!("did you mean `{m}`? It exports: {list}")),
-                        None => d.hint(format!("it exports: {list}")),
-                    });
-                }
-                Some(Some(alias)) => {
-                    let alias = alias.clone();
-                    let mut segs = self.segs(s, &alias)?;
-                    if let Some(i) = next.index {
-                        if let Some(last) = segs.last_mut() {
-                            if last.index.is_none() {
-                                last.index = Some(i);
-                            }
-                        }
-                    }
-                    segs.extend_from_slice(&rest[1..]);
-                    return self.resolve(s, &segs, span);
-                }
-                Some(None) => {}
-            }
-        }
-        match self.scopes[s].names.get(&key).cloned() {
-            Some(n) => self.follow(n, next, &rest[1..], span),
-            None => {
-                let comp = self.scopes[s]
-                    .instance
-                    .clone()
-                    .map(|i| i.0)
-                    .unwrap_or_default();
-                let names: Vec<String> = self.scopes[s].names.keys().cloned().collect();
-                let d =
-                    Diagnostic::error(Code::E0201, format!("component `{comp}` has no `{key}`"))
-                        .at(next.name.span, "not declared in the component");
-                Err(match did_you_mean(&key, names.iter().map(|n| n.as_str())) {
-                    Some(m) => d.hint(format!("did you mean `{m}`?")),
-                    None => d.hint(format!("it declares: {}", names.join(", "))),
-                })
-            }
-        }
     }
 
     /// The expression of property `prop` of a declaration, if written.

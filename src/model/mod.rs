@@ -17,6 +17,7 @@ mod exact;
 pub use exact::channel_dim;
 mod output_calls;
 mod outputs;
+mod resolve;
 mod settings;
 pub mod topology;
 mod types;
