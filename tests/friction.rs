@@ -261,4 +261,6 @@ solve hht { dt = 0.01 s, until = 0.1 s }
         "{d:#?}"
     );
     assert!(d[2].message.contains("`unused`"), "{}", d[2].message);
+    // The label stays on the declaration's line (no trailing whitespace in spans).
+    assert_eq!(spanned(text, &d[2], 0), "param unused = 2");
 }

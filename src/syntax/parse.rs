@@ -179,9 +179,12 @@ fn internal(what: &str) -> Diagnostic {
 }
 
 impl Cx {
+    /// The pair's span without the whitespace pest's implicit separators leave at its end, so
+    /// a label under a declaration stays on its lines.
     fn span(&self, p: &Pair<Rule>) -> Span {
         let s = p.as_span();
-        Span::new(self.source, s.start(), s.end())
+        let text = p.as_str();
+        Span::new(self.source, s.start(), s.start() + text.trim_end().len())
     }
 
     fn ident(&self, p: Pair<Rule>) -> Ident {
