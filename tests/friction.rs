@@ -264,3 +264,65 @@ solve hht { dt = 0.01 s, until = 0.1 s }
     // The label stays on the declaration's line (no trailing whitespace in spans).
     assert_eq!(spanned(text, &d[2], 0), "param unused = 2");
 }
+
+#[test]
+fn unit_errors_name_quantities_and_the_param_that_holds_the_value() {
+    let text = "model m
+param EI = 100 N*m
+section s { EA = 1e7 N, GA2 = 1e6 N, GA3 = 1e6 N, GJ = 1e3 N*m^2, EI2 = EI, EI3 = 1e3 N*m^2, mass_per_length = 1 kg/m }
+ground earth
+beam blade { from = (0, 0, 0) m, to = (2, 0, 0) m, section = s, elements = 2 }
+joint clamp = fixed(earth, blade.start)
+rigid_rod bar { from = (0, 0, 0) m, to = (0, 1, 0) m, mass = 1 kg }
+joint pin = revolute(earth, bar.start) { axis = z, torque = 2 N }
+torsional_spring twist(earth @ (0, 1, 0) m, bar.end) { stiffness = 3 N/m }
+solve hht { dt = 1 ms, until = 1 s }
+";
+    let d = errors(text);
+    assert_eq!(
+        codes(&d),
+        vec![Code::E0202, Code::E0202, Code::E0202],
+        "{d:#?}"
+    );
+    let ei = &d[0];
+    assert_eq!(
+        ei.message,
+        "`EI2` must be a bending stiffness [N*m^2], found a moment [N*m]"
+    );
+    // At the use, then at the param.
+    assert_eq!(spanned(text, ei, 0), "EI");
+    assert_eq!(ei.labels[0].text, "this is a moment [N*m]");
+    assert_eq!(spanned(text, ei, 1), "param EI = 100 N*m");
+    assert_eq!(ei.labels[1].text, "defined here as a moment [N*m]");
+    let texts: Vec<&str> = d[1..].iter().map(|d| d.message.as_str()).collect();
+    assert!(
+        texts.contains(
+            &"`stiffness` must be a torsional stiffness [N*m/rad], found a stiffness [N/m]"
+        ),
+        "{texts:?}"
+    );
+    assert!(
+        texts.contains(&"`torque` must be a torque [N*m], found a force [N]"),
+        "{texts:?}"
+    );
+    // A component argument: the same, through the argument to the param.
+    let text = "model m
+use stdlib::rod::hinged_rod
+param h = 1.5
+ground earth
+arm = hinged_rod(base = earth, root = (0,0,0) m, direction = x, length = h, mass = 1 kg)
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let d = errors(text);
+    assert_eq!(codes(&d), vec![Code::E0215]);
+    assert_eq!(
+        d[0].message,
+        "argument `length` of `hinged_rod` must be a length [m]"
+    );
+    assert_eq!(d[0].labels[0].text, "this is a dimensionless number");
+    assert_eq!(spanned(text, &d[0], 1), "param h = 1.5");
+    assert_eq!(
+        d[0].labels[1].text,
+        "defined here as a dimensionless number"
+    );
+}

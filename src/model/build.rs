@@ -5,7 +5,7 @@
 use super::elaborate::{unused_bindings, Elaborator};
 use super::env::{is_secondary, BindingKind, Env, Named, ScopeId};
 use super::eval::Value;
-use super::units::Dim;
+use super::units::{Dim, Quantity};
 use super::*;
 use crate::diagnostics::{did_you_mean, merge_repeats, Code, Diagnostic, Sink};
 use crate::source::SourceMap;
@@ -516,7 +516,7 @@ impl Builder<'_> {
         &mut self,
         scope: ScopeId,
         e: &Expr,
-        dim: Dim,
+        want: Quantity,
         what: &str,
         vector: bool,
     ) -> Option<Value> {
@@ -530,48 +530,74 @@ impl Builder<'_> {
             (Value::Scalar { .. }, true)
             | (Value::Vector { .. }, false)
             | (Value::Rotation { .. }, _) => {
-                let want = if vector {
+                let shape = if vector {
                     "a vector `(x, y, z)`"
                 } else {
                     "a scalar"
                 };
                 Diagnostic::error(
                     Code::E0209,
-                    format!("{what} must be {want}, found {}", v.kind_name()),
+                    format!("{what} must be {shape}, found {}", v.kind_name()),
                 )
                 .at(e.span, format!("this is {}", v.kind_name()))
             }
-            _ if v.dim() != dim => Diagnostic::error(
-                Code::E0202,
-                format!(
-                    "{what} must be a {}, found a {}",
-                    dim.describe(),
-                    v.dim().describe()
-                ),
-            )
-            .at(e.span, format!("this is a {}", v.dim().describe())),
+            _ if v.dim() != want.dim => self.mismatch(scope, e, want, v.dim(), what),
             _ => return Some(v),
         };
         let hint = if let Value::Signal { .. } = v {
             "only loads, prescribed motions and functions may depend on `t`".to_string()
         } else if vector && !matches!(v, Value::Vector { .. }) {
-            format!("write `(x, y, z)`; {}", unit_hint(dim))
+            format!("write `(x, y, z)`; {}", unit_hint(want, vector))
         } else {
-            unit_hint(dim)
+            unit_hint(want, vector)
         };
         self.error(scope, error.hint(hint));
         None
     }
 
-    pub fn scalar(&mut self, scope: ScopeId, e: &Expr, dim: Dim, what: &str) -> Option<f64> {
-        match self.typed(scope, e, dim, what, false)? {
+    /// E0202 for `e`, found of dimension `found` where `want` is needed: at the use, and at
+    /// the definition of the param or let it names.
+    fn mismatch(
+        &self,
+        scope: ScopeId,
+        e: &Expr,
+        want: Quantity,
+        found: Dim,
+        what: &str,
+    ) -> Diagnostic {
+        let found = found.describe();
+        let d = Diagnostic::error(
+            Code::E0202,
+            format!("{what} must be {}, found {found}", want.describe()),
+        )
+        .at(e.span, format!("this is {found}"));
+        match self.env.definition(scope, e) {
+            Some((span, how)) => d.at(span, format!("{how} as {found}")),
+            None => d,
+        }
+    }
+
+    pub fn scalar(
+        &mut self,
+        scope: ScopeId,
+        e: &Expr,
+        want: impl Into<Quantity>,
+        what: &str,
+    ) -> Option<f64> {
+        match self.typed(scope, e, want.into(), what, false)? {
             Value::Scalar { value, .. } => Some(value),
             _ => None,
         }
     }
 
-    pub fn vector(&mut self, scope: ScopeId, e: &Expr, dim: Dim, what: &str) -> Option<[f64; 3]> {
-        match self.typed(scope, e, dim, what, true)? {
+    pub fn vector(
+        &mut self,
+        scope: ScopeId,
+        e: &Expr,
+        want: impl Into<Quantity>,
+        what: &str,
+    ) -> Option<[f64; 3]> {
+        match self.typed(scope, e, want.into(), what, true)? {
             Value::Vector { value, .. } => Some(value),
             _ => None,
         }
@@ -613,29 +639,19 @@ impl Builder<'_> {
         &mut self,
         scope: ScopeId,
         e: &Expr,
-        dim: Dim,
+        want: impl Into<Quantity>,
         what: &str,
         vector: bool,
     ) -> Option<Vec<TimeFn>> {
+        let want = want.into();
         let v = self.value(scope, e)?;
         let parts = v.parts();
-        let want = if vector { 3 } else { 1 };
+        let count = if vector { 3 } else { 1 };
         match parts {
-            Some((p, d)) if p.len() == want && d == dim => Some(p),
-            Some((p, d)) if p.len() == want => {
-                self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0202,
-                        format!(
-                            "{what} must be a {}, found a {}",
-                            dim.describe(),
-                            d.describe()
-                        ),
-                    )
-                    .at(e.span, format!("this is a {}", d.describe()))
-                    .hint(unit_hint(dim)),
-                );
+            Some((p, d)) if p.len() == count && d == want.dim => Some(p),
+            Some((p, d)) if p.len() == count => {
+                let error = self.mismatch(scope, e, want, d, what);
+                self.error(scope, error.hint(unit_hint(want, vector)));
                 None
             }
             _ => {
@@ -651,7 +667,7 @@ impl Builder<'_> {
                         format!("{what} must be {shape}, found {}", v.kind_name()),
                     )
                     .at(e.span, format!("this is {}", v.kind_name()))
-                    .hint(unit_hint(dim)),
+                    .hint(unit_hint(want, vector)),
                 );
                 None
             }
@@ -824,22 +840,22 @@ pub(super) fn written_names(item: &Item) -> Vec<String> {
         .collect()
 }
 
-pub(super) fn unit_hint(dim: Dim) -> String {
-    let example = match (dim.mass, dim.length, dim.time) {
-        (1, 0, 0) => "`1.0 kg`",
-        (0, 1, 0) => "`0.5 m` or `(0, -0.5, 0) m`",
-        (0, 0, 1) => "`0.005 s`",
-        (0, 1, -1) => "`1.5 m/s` or `(1.5, 0, 0) m/s`",
-        (0, 1, -2) => "`(0, -9.81, 0) m/s^2`",
-        (0, 0, -1) => "`98.17 rad/s`",
-        (1, 1, -2) => "`20 N` or `(20, 0, 0) N`",
-        (1, 2, -2) => "`14 N*m` (or `14 N*m/rad` for a torsional stiffness)",
-        (1, 0, -2) => "`15434 N/m`",
-        (1, 2, 0) => "`48.6 kg*m^2`",
-        (0, 0, 0) => "a plain number",
-        _ => "a value with units",
+/// "expected a length [m], e.g. `0.5 m`" (a vector of it: "`(0, 0, 0.5) m`").
+pub(super) fn unit_hint(want: Quantity, vector: bool) -> String {
+    let example = match (vector, want.dim.is_none()) {
+        (false, _) => want.example(),
+        (true, true) => "`(1, 0, 0)`".to_string(),
+        (true, false) => {
+            let e = want.example();
+            // `0.5 m` -> `(0, 0, 0.5) m`
+            let inner = e.trim_matches('`');
+            match inner.split_once(' ') {
+                Some((x, unit)) => format!("`(0, 0, {x}) {unit}`"),
+                None => format!("`(0, 0, {inner})`"),
+            }
+        }
     };
-    format!("expected a {}, e.g. {example}", dim.describe())
+    format!("expected {}, e.g. {example}", want.describe())
 }
 
 pub(super) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

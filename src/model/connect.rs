@@ -2,12 +2,11 @@
 
 use super::build::{add, cross, dot, norm, scale, sub, Builder, Built, View};
 use super::env::Ref;
-use super::units::Dim;
+use super::units::{self, Dim, Quantity};
 use super::*;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
 use crate::syntax::ast::{Item, MarkerRef};
 
-const TORQUE: Dim = Dim::new(1, 2, -2);
 const RATE: Dim = Dim::new(0, 0, -1);
 
 /// The joint kinds, for "did you mean".
@@ -162,11 +161,13 @@ impl Builder<'_> {
             }
             true
         };
-        let scalar = |this: &mut Self, key: &str, dim: Dim| match this.expr(scope, p.get(key)) {
+        let scalar = |this: &mut Self, key: &str, dim: Quantity| match this.expr(scope, p.get(key))
+        {
             Some(e) => this.scalar(scope, e, dim, &format!("`{key}`")),
             None => Some(0.0),
         };
-        let signal = |this: &mut Self, key: &str, dim: Dim| match this.expr(scope, p.get(key)) {
+        let signal = |this: &mut Self, key: &str, dim: Quantity| match this.expr(scope, p.get(key))
+        {
             Some(e) => this
                 .signal(scope, e, dim, &format!("`{key}`"), false)
                 .map(|mut v| Some(v.remove(0))),
@@ -179,15 +180,23 @@ impl Builder<'_> {
                 if !coincide(self, if rev { None } else { Some(n) }) {
                     return;
                 }
-                let (kdim, cdim, qdim) = if rev {
-                    (TORQUE, Dim::new(1, 2, -1), Dim::NONE)
+                let (kdim, cdim, qdim): (Quantity, Quantity, Quantity) = if rev {
+                    (
+                        units::TORSIONAL_STIFFNESS,
+                        Dim::new(1, 2, -1).into(),
+                        units::ANGLE,
+                    )
                 } else {
-                    (Dim::new(1, 0, -2), Dim::new(1, 0, -1), Dim::LENGTH)
+                    (
+                        Dim::new(1, 0, -2).into(),
+                        Dim::new(1, 0, -1).into(),
+                        Dim::LENGTH.into(),
+                    )
                 };
                 let spring = scalar(self, "spring", kdim);
                 let damper = scalar(self, "damper", cdim);
                 let rest = if rev {
-                    scalar(self, "rest_angle", Dim::NONE)
+                    scalar(self, "rest_angle", units::ANGLE)
                 } else {
                     Some(0.0)
                 };
@@ -197,8 +206,16 @@ impl Builder<'_> {
                     ("displacement", "speed", "force")
                 };
                 let position = signal(self, pos_key, qdim);
-                let rate = signal(self, rate_key, qdim.over(Dim::TIME));
-                let load = signal(self, load_key, if rev { TORQUE } else { Dim::FORCE });
+                let rate = signal(self, rate_key, qdim.dim.over(Dim::TIME).into());
+                let load = signal(
+                    self,
+                    load_key,
+                    if rev {
+                        units::TORQUE
+                    } else {
+                        Dim::FORCE.into()
+                    },
+                );
                 let (
                     Some(spring),
                     Some(damper),
@@ -376,12 +393,12 @@ impl Builder<'_> {
         };
         let p = self.props(v.scope, v.block.as_ref(), known, &format!("a {k}"));
         let pair = self.pair(v.scope, k, &v.name, &v.markers, v.span);
-        let (kdim, cdim) = if torsional {
-            (TORQUE, Dim::new(1, 2, -1))
+        let (kdim, cdim): (Quantity, Quantity) = if torsional {
+            (units::TORSIONAL_STIFFNESS, Dim::new(1, 2, -1).into())
         } else {
-            (Dim::new(1, 0, -2), Dim::new(1, 0, -1))
+            (Dim::new(1, 0, -2).into(), Dim::new(1, 0, -1).into())
         };
-        let get = |this: &mut Self, key: &str, dim: Dim, required: bool| match this
+        let get = |this: &mut Self, key: &str, dim: Quantity, required: bool| match this
             .expr(v.scope, p.get(key))
         {
             Some(e) => this.scalar(v.scope, e, dim, &format!("`{key}`")),
@@ -468,8 +485,12 @@ impl Builder<'_> {
         }
         let (on, value) = (v.on.clone()?, v.value.clone()?);
         let marker = self.marker(v.scope, &on);
-        let dim = if k == "force" { Dim::FORCE } else { TORQUE };
-        let parts = self.signal(v.scope, &value, dim, &format!("a {k}"), true);
+        let dim = if k == "force" {
+            Dim::FORCE.into()
+        } else {
+            units::TORQUE
+        };
+        let parts = self.signal(v.scope, &value, dim, &format!("{k} `{}`", v.name), true);
         let (marker, parts) = (marker?, parts?);
         if let Attach::Ground { .. } = marker.attach {
             self.error(

@@ -16,7 +16,7 @@ use super::units::Dim;
 use crate::diagnostics::{Code, Diagnostic, Iteration};
 use crate::runtime::timefn::TimeFn;
 use crate::source::Span;
-use crate::syntax::ast::{Component, Expr, Ident, Item, Path, PropValue};
+use crate::syntax::ast::{Component, Expr, ExprKind, Ident, Item, Path, PropValue};
 use std::collections::{BTreeMap, HashMap};
 use std::rc::Rc;
 
@@ -400,8 +400,45 @@ impl Env {
         match self.eval_in(scope, expr)? {
             Value::Scalar { value, dim } if dim.is_none() && value.fract() == 0.0 && value.abs() < 1e9 => Ok(value as i64),
             v => Err(Diagnostic::error(Code::E0214, format!("{what} must be a whole number"))
-                .at(expr.span, format!("this is {} {}", v.kind_name(), if v.dim().is_none() { String::new() } else { v.dim().describe() }))
+                .at(expr.span, match &v { Value::Scalar { value, dim } if dim.is_none() => format!("this is {value}"), Value::Scalar { dim, .. } => format!("this is {}", dim.describe()), v => format!("this is {}", v.kind_name()) })
                 .hint("indices and loop bounds are dimensionless integers, e.g. `blade[i]` with `for i in 0..N`")),
+        }
+    }
+
+    /// Where the value of `e` was defined, when `e` names a param, a let or a function (the
+    /// declaration) or a component argument (the value given to the instance, or what that
+    /// names in turn): a second place to look when the value is wrong where it is used.
+    pub fn definition(&self, scope: ScopeId, e: &Expr) -> Option<(Span, &'static str)> {
+        self.definition_at(scope, e, 0)
+    }
+
+    fn definition_at(
+        &self,
+        scope: ScopeId,
+        e: &Expr,
+        depth: usize,
+    ) -> Option<(Span, &'static str)> {
+        let ExprKind::Path { path } = &e.kind else {
+            return None;
+        };
+        let Some(Named::Binding(id)) = self.lookup(scope, &path.single()?.name) else {
+            return None;
+        };
+        let b = &self.bindings[id];
+        match b.kind {
+            BindingKind::Param | BindingKind::Let | BindingKind::Function => {
+                Some((b.span, "defined here"))
+            }
+            BindingKind::Arg => {
+                let given = b.expr.as_ref()?;
+                let further = if depth < 8 {
+                    self.definition_at(b.scope, given, depth + 1)
+                } else {
+                    None
+                };
+                further.or(Some((given.span, "given here")))
+            }
+            BindingKind::LoopVar => None,
         }
     }
 
@@ -485,8 +522,8 @@ impl Env {
                     g if g.dim().is_none() && !v.dim().is_none() => Ok(g.with_dim(v.dim())),
                     g if g.dim() == v.dim() && std::mem::discriminant(&g) == std::mem::discriminant(&v) => Ok(g),
                     g => Err(Diagnostic::error(Code::E0202, format!("`--set {name}` has the wrong dimension"))
-                        .at(set.span, format!("this is a {}", g.dim().describe()))
-                        .hint(format!("`{name}` is a {}; give a plain number in SI units or a value with matching units", v.dim().describe()))),
+                        .at(set.span, format!("this is {}", g.dim().describe()))
+                        .hint(format!("`{name}` is {}; give a plain number in SI units or a value with matching units", v.dim().describe()))),
                 };
             }
         }
@@ -494,13 +531,17 @@ impl Env {
             if let Err(found) = ty.accepts(&v) {
                 let comp = b.component.clone().unwrap_or_default();
                 let name = b.name.clone();
-                return Err(Diagnostic::error(
+                let mut d = Diagnostic::error(
                     Code::E0215,
                     format!("argument `{name}` of `{comp}` must be {}", ty.describe()),
                 )
-                .at(expr.span, format!("this is {found}"))
-                .at(tspan, "declared here")
-                .hint(ty.example()));
+                .at(expr.span, format!("this is {found}"));
+                if let Some((span, how)) = self.definition(b.scope, expr) {
+                    d = d.at(span, format!("{how} as {found}"));
+                }
+                return Err(d
+                    .at(tspan, format!("declared here as `{name}: {}`", ty.name()))
+                    .hint(ty.example()));
             }
             if let ParamType::Direction = ty {
                 if let Value::Vector { value, .. } = v {
