@@ -63,6 +63,7 @@ const CASES: &[(&str, Code)] = &[
     ("exact_twice", Code::E0406),
     ("exact_not_a_function", Code::E0407),
     ("unused_declaration", Code::W0202),
+    ("angle_without_unit", Code::W0203),
     ("floating_body", Code::W0301),
 ];
 

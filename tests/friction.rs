@@ -326,3 +326,68 @@ solve hht { dt = 0.01 s, until = 0.1 s }
         "defined here as a dimensionless number"
     );
 }
+
+#[test]
+fn an_angle_without_a_unit_is_a_warning() {
+    let text = "model m
+param theta = 10
+param phi = 20 deg
+ground earth
+component arm(a: angle, at: position) {
+    rigid_rod bar { from = at, to = at + (1, 0, 0) m, mass = 1 kg }
+    joint hinge = revolute(earth @ at, bar.start) { axis = z, spring = 1 N*m/rad, rest_angle = a }
+}
+x = arm(a = 45, at = (0, 1, 0) m)
+y = arm(a = phi, at = (0, 2, 0) m)
+rigid_rod bar { from = (0, 0, 0) m, to = (1, 0, 0) m, mass = 1 kg, angular_velocity = rotate(z, 3) * (0, 0, 1) rad/s }
+joint hinge = revolute(earth, bar.start) { axis = z, spring = 10 N*m/rad, rest_angle = 3 }
+rigid_rod bar2 { from = (0, 0, 2) m, to = (1, 0, 2) m, mass = 1 kg }
+joint h2 = revolute(earth @ (0, 0, 2) m, bar2.start) { axis = z, angle = theta * sin(2 * t / 1 s) }
+rigid_rod bar3 { from = (0, 0, 3) m, to = (1, 0, 3) m, mass = 1 kg }
+joint h3 = revolute(earth @ (0, 0, 3) m, bar3.start) { axis = z, angle = 0.1 * sin(2 rad/s * t), spring = 1 N*m/rad, rest_angle = pi / 6 }
+force f on bar3.end = (0, 1, 0) N * sine(1, 2 rad/s, 1)
+rigid_rod bar4 { from = (0, 0, 4) m, to = (1, 0, 4) m, mass = 1 kg }
+joint h4 = revolute(earth @ (0, 0, 4) m, bar4.start) { axis = z, spring = 1 N*m/rad, rest_angle = 0 }
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let w = match check(text) {
+        Ok(w) => w,
+        Err((d, _)) => panic!("{d:#?}"),
+    };
+    assert!(w.iter().all(|d| d.code == Code::W0203), "{w:#?}");
+    let found: Vec<(&str, &str)> = w
+        .iter()
+        .map(|d| (spanned(text, d, 0), d.message.as_str()))
+        .collect();
+    // The argument is reported where it is given, once (not again at `rest_angle = a`);
+    // `phi` (deg), `0.1 * sin(2 rad/s * t)` (rad), `pi / 6` and `0` are angles.
+    assert_eq!(
+        found,
+        vec![
+            (
+                "3",
+                "`rest_angle` has no angle unit: 3 is read as 3 rad (171.9 deg)"
+            ),
+            (
+                "theta * sin(2 * t / 1 s)",
+                "the prescribed `angle` has no angle unit, so it is read in radians"
+            ),
+            (
+                "3",
+                "the angle of `rotate` has no angle unit: 3 is read as 3 rad (171.9 deg)"
+            ),
+            (
+                "1",
+                "the phase of `sine` has no angle unit: 1 is read as 1 rad (57.3 deg)"
+            ),
+            (
+                "45",
+                "argument `a` of `arm` has no angle unit: 45 is read as 45 rad (2578 deg)"
+            ),
+        ]
+    );
+    assert_eq!(
+        w[0].hint.as_deref(),
+        Some("write `3 deg` for degrees, or `3 rad` to say it is radians")
+    );
+}

@@ -246,6 +246,14 @@ Newmark family (`hht`, `generalized_alpha`) only.";
     W0202 = "W0202", "unused declaration",
         "A let, a function, a section or a component is declared in the model file but never \
 used. Remove it, or use it.";
+    W0203 = "W0203", "angle without a unit",
+        "An angle is given as a bare number, so it is read in radians: `rest_angle = 3` is 3 rad \
+(172 deg), not 3 deg. Angles are dimensionless, so the compiler cannot tell; it warns when an \
+angle (a revolute joint's `rest_angle` or prescribed `angle`, a beam's `twist`, the angle of \
+`rotate(axis, angle)`, the phase of `sine`, a component argument of type `angle`) is not zero \
+and its expression names no angle: no `rad`, `deg` or `rev` in a unit (`rad/s` counts), no \
+`pi`, no `asin`, `acos`, `atan` or `atan2`, also through the params, lets and arguments it uses. \
+Write `3 deg`, or `3 rad` to keep radians and silence the warning.";
     W0301 = "W0301", "body not connected to ground",
         "No chain of joints, springs or beams connects the body to a ground, so it floats: the \
 warning names the free motions. That is right for a free-flight test and wrong almost everywhere \

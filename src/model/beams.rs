@@ -329,7 +329,13 @@ impl Builder<'_> {
             None => Some(3),
         };
         let twist = match self.expr(v.scope, p.get("twist")) {
-            Some(e) => self.scalar(v.scope, e, Dim::NONE, "`twist`"),
+            Some(e) => {
+                let x = self.scalar(v.scope, e, units::ANGLE, "`twist`");
+                if x.is_some() {
+                    self.angle_unit(v.scope, Some(e), x, "`twist`");
+                }
+                x
+            }
             None => Some(0.0),
         };
         let e2 = match self.expr(v.scope, p.get("e2")) {

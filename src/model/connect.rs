@@ -20,7 +20,29 @@ const JOINTS: &[&str] = &[
     "distance",
 ];
 
+/// A property's expression, if it is one (not a block).
+fn prop_expr(p: &crate::syntax::ast::Prop) -> Option<&crate::syntax::ast::Expr> {
+    match &p.value {
+        crate::syntax::ast::PropValue::Expr(e) => Some(e),
+        crate::syntax::ast::PropValue::Block(_) => None,
+    }
+}
+
 impl Builder<'_> {
+    /// W0203 if the angle `e` of `what` is a bare number (`value`: its constant value, `None`
+    /// for a function of time).
+    pub(super) fn angle_unit(
+        &mut self,
+        scope: usize,
+        e: Option<&crate::syntax::ast::Expr>,
+        value: Option<f64>,
+        what: &str,
+    ) {
+        if let Some(d) = e.and_then(|e| self.env.bare_angle(scope, e, value, what)) {
+            self.error(scope, d);
+        }
+    }
+
     /// Resolves the two markers of a connection and rejects one that connects nothing.
     fn pair(
         &mut self,
@@ -227,6 +249,13 @@ impl Builder<'_> {
                 else {
                     return;
                 };
+                if rev {
+                    let rest_expr = p.get("rest_angle").and_then(|q| prop_expr(q));
+                    self.angle_unit(scope, rest_expr, Some(rest), "`rest_angle`");
+                    let f = position.as_ref().map(|f| f.as_constant());
+                    let angle_expr = p.get("angle").and_then(|q| prop_expr(q));
+                    self.angle_unit(scope, angle_expr, f.flatten(), "the prescribed `angle`");
+                }
                 let drives: Vec<&str> = [
                     (pos_key, position.is_some()),
                     (rate_key, rate.is_some()),

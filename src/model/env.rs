@@ -543,6 +543,20 @@ impl Env {
                     .at(tspan, format!("declared here as `{name}: {}`", ty.name()))
                     .hint(ty.example()));
             }
+            if let (ParamType::Scalar(q), Value::Scalar { value, .. }) = (ty, &v) {
+                if q == super::units::ANGLE {
+                    let what = format!(
+                        "argument `{}` of `{}`",
+                        b.name,
+                        b.component.clone().unwrap_or_default()
+                    );
+                    let scope = b.scope;
+                    if let Some(d) = self.bare_angle(scope, expr, Some(*value), &what) {
+                        let d = self.trace(scope, d);
+                        self.errors.push(d);
+                    }
+                }
+            }
             if let ParamType::Direction = ty {
                 if let Value::Vector { value, .. } = v {
                     let n =
@@ -704,6 +718,13 @@ impl Names for Cx<'_> {
             v = component(v, seg)?;
         }
         Ok(v)
+    }
+
+    fn angle(&mut self, e: &Expr, value: f64, what: &str) {
+        if let Some(d) = self.env.bare_angle(self.scope, e, Some(value), what) {
+            let d = self.env.trace(self.scope, d);
+            self.env.errors.push(d);
+        }
     }
 
     fn function(&mut self, name: &Ident) -> Result<Option<Value>, Diagnostic> {

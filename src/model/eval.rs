@@ -110,6 +110,8 @@ pub trait Names {
     fn path(&mut self, path: &Path) -> Result<Value, Diagnostic>;
     /// A user function called as `name(arg)`, if one is declared.
     fn function(&mut self, name: &Ident) -> Result<Option<Value>, Diagnostic>;
+    /// `e`, of constant value `value`, is the angle of `what`: warn if it has no unit (W0203).
+    fn angle(&mut self, _e: &Expr, _value: f64, _what: &str) {}
 }
 
 pub fn eval(expr: &Expr, names: &mut dyn Names) -> Result<Value, Diagnostic> {
@@ -717,6 +719,7 @@ fn call(
                 .at(args[1].span, format!("this is {}", d.describe()))
                 .hint("write an angle such as `30 deg` or `0.5 rad`"));
             }
+            names.angle(&args[1], angle, "the angle of `rotate`");
             Ok(Value::Rotation {
                 matrix: rotation(n.map(|x| x / len), angle),
             })
@@ -767,6 +770,7 @@ fn call(
                         .at(args[2].span, format!("this is {}", d.describe()))
                         .hint("write the phase in rad or deg"));
                     }
+                    names.angle(&args[2], x, "the phase of `sine`");
                     x
                 }
                 None => 0.0,
