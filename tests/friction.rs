@@ -391,3 +391,38 @@ solve hht { dt = 0.01 s, until = 0.1 s }
         Some("write `3 deg` for degrees, or `3 rad` to say it is radians")
     );
 }
+
+#[test]
+fn initial_motion_of_a_family_moves_every_member() {
+    // A family of bodies and a family of instances.
+    let text = "model fan
+ground earth
+component pendulum(x: length) {
+    point_mass bob { mass = 1 kg, at = (x, -1 m, 0) }
+    joint link = distance(earth @ (x, 0 m, 0), bob)
+}
+for i in 0..3 {
+    rigid_rod blade[i] { from = (0, 0, 0) m, to = rotate(z, i * 120 deg) * (1, 0, 0) m, mass = 1 kg }
+    joint hinge[i] = revolute(earth, blade[i].start) { axis = z }
+    p[i] = pendulum(x = (i + 2) * 1 m)
+}
+initial spin of blade = 2 rad/s about z
+initial velocity of p = (0, 0, 1) m/s
+output v0 = blade[0].end.velocity, v1 = blade[1].end.velocity, v2 = blade[2].end.velocity,
+       w2 = blade[2].angular_velocity, u0 = p[0].bob.velocity, u2 = p[2].bob.velocity
+solve hht { dt = 1 ms, until = 0.01 s }
+";
+    let t = run(text);
+    let at0 = |c: &str| t.col(c)[0];
+    for (k, v) in ["v0", "v1", "v2"].iter().enumerate() {
+        // omega x r with r = 1 m at 120 deg steps: 2 m/s along the tangent.
+        let a = (k as f64 * 120.0).to_radians();
+        assert!((at0(&format!("{v}.x")) + 2.0 * a.sin()).abs() < 1e-9, "{v}");
+        assert!((at0(&format!("{v}.y")) - 2.0 * a.cos()).abs() < 1e-9, "{v}");
+    }
+    assert!((at0("w2.z") - 2.0).abs() < 1e-12);
+    assert_eq!((at0("u0.z"), at0("u2.z")), (1.0, 1.0));
+    // A family of something that does not move is still an error, with its code.
+    let d = errors(&text.replace("initial spin of blade", "initial spin of hinge"));
+    assert!(codes(&d).contains(&Code::E0222), "{d:#?}");
+}

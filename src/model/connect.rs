@@ -1,7 +1,7 @@
 //! Joints, springs and dampers, loads, and initial motion.
 
 use super::build::{add, cross, dot, norm, scale, sub, Builder, Built, View};
-use super::env::Ref;
+use super::env::{Member, Ref};
 use super::units::{self, Dim, Quantity};
 use super::*;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
@@ -547,7 +547,8 @@ impl Builder<'_> {
     }
 
     /// `initial spin of PATH = rate about AXIS through POINT`, `initial velocity of PATH = v`:
-    /// adds a rigid motion to every body and beam node of an instance, or to one body.
+    /// adds a rigid motion to every body and beam node of an instance, to one body or beam, or
+    /// to every member of a family of them (`blade`, declared in a loop).
     pub(super) fn initial(&mut self, item: &Item, scope: usize) {
         let Item::Initial {
             what,
@@ -582,33 +583,40 @@ impl Builder<'_> {
             Ok(s) => s,
             Err(d) => return self.error(scope, d),
         };
-        let prefix = match self.env.resolve(scope, &segs, target.span) {
-            Ok((Ref::Instance(s), rest)) if rest.is_empty() => self.env.scopes[s].prefix.clone(),
-            Ok((Ref::Decl(d), rest))
-                if rest.is_empty()
-                    && matches!(self.built[d], Some(Built::Body(_)) | Some(Built::Beam(_))) =>
-            {
-                self.env.decls[d].name.clone()
-            }
-            // A body that failed to build: its error has been reported.
-            Ok((Ref::Decl(d), rest))
-                if rest.is_empty() && self.failed_within(&self.env.decls[d].name) =>
-            {
-                return
-            }
-            Ok(_) => {
-                return self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0222,
-                        "initial motion applies to a body, a beam or a component instance",
-                    )
-                    .at(target.span, "not a body, beam or instance")
-                    .hint("name a body (`hub`), a beam, or an instance (`rotor`)"),
+        // What it moves: a body, a beam, an instance, or every member of a family of them.
+        let not_movable = |this: &mut Self| {
+            this.error(
+                scope,
+                Diagnostic::error(
+                    Code::E0222,
+                    "initial motion applies to a body, a beam or a component instance",
                 )
-            }
+                .at(target.span, "not a body, beam or instance")
+                .hint("name a body (`hub`), a beam, an instance (`rotor`), or a family of them (`blade`)"),
+            )
+        };
+        let members = match self.env.resolve_family(scope, &segs, target.span) {
+            Ok((_, rest)) if !rest.is_empty() => return not_movable(self),
+            Ok((Ref::Instance(s), _)) => vec![Member::Instance(s)],
+            Ok((Ref::Decl(d), _)) => vec![Member::Decl(d)],
+            Ok((Ref::Family(m), _)) => m.into_iter().map(|x| x.1).collect(),
+            Ok(_) => return not_movable(self),
             Err(d) => return self.error(scope, d),
         };
+        let mut prefixes = Vec::new();
+        for m in members {
+            match m {
+                Member::Instance(s) => prefixes.push(self.env.scopes[s].prefix.clone()),
+                Member::Decl(d)
+                    if matches!(self.built[d], Some(Built::Body(_)) | Some(Built::Beam(_))) =>
+                {
+                    prefixes.push(self.env.decls[d].name.clone())
+                }
+                // A body that failed to build: its error has been reported.
+                Member::Decl(d) if self.failed_within(&self.env.decls[d].name) => return,
+                Member::Decl(_) => return not_movable(self),
+            }
+        }
         let (w, v, p) = if spin {
             let rate = self.scalar(scope, value, RATE, "the spin rate");
             let axis = match about {
@@ -646,9 +654,11 @@ impl Builder<'_> {
             ([0.0; 3], v, [0.0; 3])
         };
         let inside = |name: &str| {
-            name == prefix
-                || (prefix.ends_with('.') && name.starts_with(&prefix))
-                || name.starts_with(&format!("{prefix}."))
+            prefixes.iter().any(|prefix| {
+                name == prefix
+                    || (prefix.ends_with('.') && name.starts_with(prefix.as_str()))
+                    || name.starts_with(&format!("{prefix}."))
+            })
         };
         let mut moved = 0;
         for i in 0..self.bodies.len() {
@@ -674,7 +684,10 @@ impl Builder<'_> {
                 moved += 1;
             }
         }
-        if moved == 0 && !self.failed_within(prefix.trim_end_matches('.')) {
+        let failed = prefixes
+            .iter()
+            .any(|p| self.failed_within(p.trim_end_matches('.')));
+        if moved == 0 && !failed {
             self.error(
                 scope,
                 Diagnostic::error(Code::E0222, "this initial motion moves no body")
