@@ -146,7 +146,8 @@ fn syntax_hint(expected: &[&str]) -> String {
     } else if expected.contains(&"an expression") || expected.contains(&"a value") {
         "write a value here: a number with an optional unit (`0.5 m`), a param name, a vector `(x, y, z)` or a call".to_string()
     } else {
-        "check the declaration against the examples in README.md".to_string()
+        "check the declaration against the examples of docs/language.md, the language reference"
+            .to_string()
     }
 }
 
