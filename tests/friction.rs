@@ -426,3 +426,24 @@ solve hht { dt = 1 ms, until = 0.01 s }
     let d = errors(&text.replace("initial spin of blade", "initial spin of hinge"));
     assert!(codes(&d).contains(&Code::E0222), "{d:#?}");
 }
+
+#[test]
+fn a_set_angle_param_is_judged_by_its_declaration() {
+    // `--set` values are SI: `tilt=0.1` is 0.1 rad, as the reference says; no W0203.
+    let text = "model m
+param tilt = 5 deg
+ground earth
+rigid_rod bar { from = (0, 0, 0) m, to = (1, 0, 0) m, mass = 1 kg }
+joint pin = revolute(earth, bar.start) { axis = z, spring = 1 N*m/rad, rest_angle = tilt }
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    match mbd::compile(
+        "m.mbd",
+        text,
+        &["tilt=0.1".to_string()],
+        Overrides::default(),
+    ) {
+        Ok(c) => assert!(c.warnings.is_empty(), "{:?}", codes(&c.warnings)),
+        Err(f) => panic!("{:?}", codes(&f.diagnostics)),
+    }
+}

@@ -78,10 +78,12 @@ impl Env {
             BindingKind::Arg if matches!(b.ty, Some((ParamType::Scalar(q), _)) if q == units::ANGLE) => {
                 true
             }
-            _ => {
-                let written = b.set.as_ref().or(b.expr.as_ref());
-                written.is_some_and(|x| self.angle_in(b.scope, x, depth + 1))
-            }
+            // A param is judged by its declaration: `--set` values are SI by contract, so
+            // `--set tilt=0.1` of `param tilt = 5 deg` is radians, and no mistake.
+            _ => b
+                .expr
+                .as_ref()
+                .is_some_and(|x| self.angle_in(b.scope, x, depth + 1)),
         }
     }
 
