@@ -226,6 +226,30 @@ solve hht { dt = 0.01 s, until = 0.1 s }
 }
 
 #[test]
+fn a_loop_whose_messages_differ_says_whose_is_shown() {
+    let text = "model m
+ground earth
+for i in 0..3 {
+    rigid_rod bar[i] { from = (i + 1, 0, 0) m, to = (i + 2, 0, 0) m, mass = 1 kg }
+    joint pin[i] = revolute(earth, bar[i].start) { axis = z }
+}
+solve hht { dt = 0.01 s, until = 0.1 s }
+";
+    let d = errors(text);
+    assert_eq!(codes(&d), vec![Code::E0310], "{d:#?}");
+    assert!(
+        d[0].message.contains("apart by 1.000000 m"),
+        "{}",
+        d[0].message
+    );
+    let last = d[0].labels.last().map(|l| l.text.as_str());
+    assert_eq!(
+        last,
+        Some("in all 3 iterations of this loop; the message is that of `i = 0`")
+    );
+}
+
+#[test]
 fn indices_that_differ_between_iterations_read_as_a_family() {
     let text = "model m
 ground earth

@@ -106,21 +106,26 @@ impl Sink {
     }
 }
 
-/// Reports each mistake once. Diagnostics with the same code, the same labelled spans and the
-/// same message up to indices are one mistake (a loop body repeats its text; a marker argument
-/// used twice repeats its error): the first is kept, with a label at each loop's header naming the iterations that
-/// hit it ("in all 3 iterations of this loop"), and indices that differ between the messages
-/// shown as `[..]`.
+/// Reports each mistake once. Diagnostics with the same code and the same labelled spans are
+/// one mistake (a loop body repeats its text; a marker argument used twice repeats its error):
+/// the first is kept, with a label at each loop's header naming the iterations that hit it
+/// ("in all 3 iterations of this loop"). Indices that differ between the messages are shown as
+/// `[..]`; where the messages differ otherwise (a distance), the label says whose is shown.
 pub fn merge_repeats(diagnostics: Vec<Diagnostic>) -> Vec<Diagnostic> {
-    let key = |d: &Diagnostic| {
-        let spans: Vec<Span> = d.labels.iter().map(|l| l.span).collect();
-        (d.code, spans, without_indices(&d.message))
-    };
+    type Key = (Code, Vec<Span>, Option<String>);
+    let mut index: std::collections::HashMap<Key, usize> = std::collections::HashMap::new();
     let mut groups: Vec<Vec<Diagnostic>> = Vec::new();
     for d in diagnostics {
-        match groups.iter_mut().find(|g| key(&g[0]) == key(&d)) {
-            Some(g) => g.push(d),
-            None => groups.push(vec![d]),
+        // Without a span, only the message tells two mistakes apart.
+        let spans: Vec<Span> = d.labels.iter().map(|l| l.span).collect();
+        let message = spans.is_empty().then(|| d.message.clone());
+        let key = (d.code, spans, message);
+        match index.get(&key) {
+            Some(&g) => groups[g].push(d),
+            None => {
+                index.insert(key, groups.len());
+                groups.push(vec![d]);
+            }
         }
     }
     groups.into_iter().map(merge_group).collect()
@@ -134,19 +139,24 @@ fn merge_group(group: Vec<Diagnostic>) -> Diagnostic {
             None => loops.push((it.header, it.var.clone(), it.count, vec![it.value])),
         }
     }
-    let messages: Vec<&str> = group.iter().map(|d| d.message.as_str()).collect();
     let mut d = group[0].clone();
-    if messages.iter().any(|m| *m != d.message) {
+    let mut shown_first = false;
+    if group.iter().any(|g| g.message != d.message) {
         let skeleton = without_indices(&d.message);
-        if messages.iter().all(|m| without_indices(m) == skeleton) {
+        if group
+            .iter()
+            .all(|g| without_indices(&g.message) == skeleton)
+        {
             d.message = skeleton;
+        } else {
+            shown_first = true;
         }
     }
-    d.iterations.clear();
+    let first = std::mem::take(&mut d.iterations);
     for (header, var, count, mut values) in loops {
         values.sort_unstable();
         values.dedup();
-        let text = match values.as_slice() {
+        let mut text = match values.as_slice() {
             // A loop of one iteration adds nothing to know.
             _ if count == 1 => continue,
             [v] => format!("in the iteration `{var} = {v}` of this loop"),
@@ -163,6 +173,13 @@ fn merge_group(group: Vec<Diagnostic>) -> Diagnostic {
                 )
             }
         };
+        if let (true, true, Some(f)) = (
+            shown_first,
+            values.len() > 1,
+            first.iter().find(|f| f.header == header),
+        ) {
+            text.push_str(&format!("; the message is that of `{var} = {}`", f.value));
+        }
         d = d.at(header, text);
     }
     d
