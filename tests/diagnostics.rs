@@ -32,6 +32,7 @@ const CASES: &[(&str, Code)] = &[
     ("marker_offset_on_point_mass", Code::E0306),
     ("unused_param", Code::W0201),
     ("several_errors", Code::E0202),
+    ("repeated_in_loop", Code::E0202),
     ("index_out_of_range", Code::E0214),
     ("component_argument", Code::E0215),
     ("module_not_found", Code::E0216),
@@ -48,6 +49,7 @@ const CASES: &[(&str, Code)] = &[
     ("multiblade_one_blade", Code::E0226),
     ("multiblade_azimuth", Code::E0227),
     ("center_of_mass_massless", Code::E0228),
+    ("missing_solve", Code::E0229),
     ("output_call_component", Code::E0212),
     ("redundant_constraints", Code::E0307),
     ("massless_motion", Code::E0308),
@@ -61,6 +63,7 @@ const CASES: &[(&str, Code)] = &[
     ("exact_twice", Code::E0406),
     ("exact_not_a_function", Code::E0407),
     ("unused_declaration", Code::W0202),
+    ("angle_without_unit", Code::W0203),
     ("floating_body", Code::W0301),
 ];
 

@@ -292,6 +292,7 @@ fn components_and_loops() {
             "rotor = lag_hinged_rotor(blades = 4, hub = tower.tip)",
             "t = tower()",
             "r[i] = rod(L = 1 m,)",
+            "arm = hinged_rod(base = earth @ (0, 0, 1) m, root = (0, 0, 1) m)",
         ],
         &[
             "rotor = lag_hinged_rotor(4)",
@@ -403,8 +404,23 @@ fn conditions_and_parts() {
             "blades = 4",
             "hub = tower.tip",
             "torque = T0 * ramp(0 s, 0.5 s)",
+            // A marker argument may carry an offset (issue 16).
+            "base = earth @ (0, 0, 1) m",
+            "hub = tower.tip @ (0, 0, h)",
+            "base = rotor.blade[2].end @ (0.1, 0, 0) m",
+            "base = mast.at(1 m) @ offset",
         ],
-        &["blades", "= 4", "4 = blades"],
+        &[
+            "blades",
+            "= 4",
+            "4 = blades",
+            // Only a path takes an offset, once, and the offset is a value.
+            "base = 2 * earth @ (0, 0, 1) m",
+            "base = (0, 0, 1) m @ earth",
+            "base = earth @",
+            "base = earth @ (0, 0, 1) m @ (1, 0, 0) m",
+            "base = @ (0, 0, 1) m",
+        ],
     );
     check(
         Rule::output_item,

@@ -7,6 +7,7 @@ mod common;
 mod diagnostics;
 mod docs;
 mod fet;
+mod friction;
 mod grammar;
 mod loads;
 mod mbc;

@@ -152,6 +152,11 @@ is taken at psi + 2 pi k / N, so blade 0 must be the one at psi = 0.";
 declared in it, recursively, with the concentrated masses they carry) or a family of them. \
 What it names is none of these (a joint, a param, a quantity), declares no bodies, or has no \
 mass at all (a massless hub), so it has no centre of mass.";
+    E0229 = "E0229", "model has no solve block",
+        "The model file has no `solve` block, so nothing says how to integrate it or for how \
+long. Add one at the top level: `solve hht { dt = 1 ms, until = 1 s }` (the method, the time \
+step or the number of steps, and the end time; section 13 of docs/language.md lists the \
+settings). Without a block, `mbd run` needs both `--until` and `--dt` (or `--steps`).";
     E0301 = "E0301", "joint connects a body to itself",
         "Both markers of a joint are on the same body, so the joint constrains nothing. Connect it \
 to another body or to ground.";
@@ -252,6 +257,14 @@ marked `frozen` on every output: they are not the system's modes.";
     W0202 = "W0202", "unused declaration",
         "A let, a function, a section or a component is declared in the model file but never \
 used. Remove it, or use it.";
+    W0203 = "W0203", "angle without a unit",
+        "An angle is given as a bare number, so it is read in radians: `rest_angle = 3` is 3 rad \
+(172 deg), not 3 deg. Angles are dimensionless, so the compiler cannot tell; it warns when an \
+angle (a revolute joint's `rest_angle` or prescribed `angle`, a beam's `twist`, the angle of \
+`rotate(axis, angle)`, the phase of `sine`, a component argument of type `angle`) is not zero \
+and its expression names no angle: no `rad`, `deg` or `rev` in a unit (`rad/s` counts), no \
+`pi`, no `asin`, `acos`, `atan` or `atan2`, also through the params, lets and arguments it uses. \
+Write `3 deg`, or `3 rad` to keep radians and silence the warning.";
     W0301 = "W0301", "body not connected to ground",
         "No chain of joints, springs or beams connects the body to a ground, so it floats: the \
 warning names the free motions. That is right for a free-flight test and wrong almost everywhere \

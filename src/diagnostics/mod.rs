@@ -35,6 +35,20 @@ pub struct Diagnostic {
     /// The first label is the primary one.
     pub labels: Vec<Label>,
     pub hint: Option<String>,
+    /// The loop iterations the diagnostic was raised in, innermost first; turned into labels
+    /// by [`merge_repeats`], which reports a mistake repeated by a loop once.
+    #[serde(skip)]
+    pub iterations: Vec<Iteration>,
+}
+
+/// One iteration of a `for` loop: the loop's header (`for i in 0..4`), its variable, the
+/// variable's value and the number of iterations.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Iteration {
+    pub header: Span,
+    pub var: String,
+    pub value: i64,
+    pub count: i64,
 }
 
 impl Diagnostic {
@@ -49,6 +63,7 @@ impl Diagnostic {
             message: message.into(),
             labels: Vec::new(),
             hint: None,
+            iterations: Vec::new(),
         }
     }
 
@@ -91,6 +106,107 @@ impl Sink {
     }
 }
 
+/// Reports each mistake once. Diagnostics with the same code and the same labelled spans are
+/// one mistake (a loop body repeats its text; a marker argument used twice repeats its error):
+/// the first is kept, with a label at each loop's header naming the iterations that hit it
+/// ("in all 3 iterations of this loop"). Indices that differ between the messages are shown as
+/// `[..]`; where the messages differ otherwise (a distance), the label says whose is shown.
+pub fn merge_repeats(diagnostics: Vec<Diagnostic>) -> Vec<Diagnostic> {
+    type Key = (Code, Vec<Span>, Option<String>);
+    let mut index: std::collections::HashMap<Key, usize> = std::collections::HashMap::new();
+    let mut groups: Vec<Vec<Diagnostic>> = Vec::new();
+    for d in diagnostics {
+        // Without a span, only the message tells two mistakes apart.
+        let spans: Vec<Span> = d.labels.iter().map(|l| l.span).collect();
+        let message = spans.is_empty().then(|| d.message.clone());
+        let key = (d.code, spans, message);
+        match index.get(&key) {
+            Some(&g) => groups[g].push(d),
+            None => {
+                index.insert(key, groups.len());
+                groups.push(vec![d]);
+            }
+        }
+    }
+    groups.into_iter().map(merge_group).collect()
+}
+
+fn merge_group(group: Vec<Diagnostic>) -> Diagnostic {
+    let mut loops: Vec<(Span, String, i64, Vec<i64>)> = Vec::new();
+    for it in group.iter().flat_map(|d| &d.iterations) {
+        match loops.iter_mut().find(|l| l.0 == it.header) {
+            Some(l) => l.3.push(it.value),
+            None => loops.push((it.header, it.var.clone(), it.count, vec![it.value])),
+        }
+    }
+    let mut d = group[0].clone();
+    let mut shown_first = false;
+    if group.iter().any(|g| g.message != d.message) {
+        let skeleton = without_indices(&d.message);
+        if group
+            .iter()
+            .all(|g| without_indices(&g.message) == skeleton)
+        {
+            d.message = skeleton;
+        } else {
+            shown_first = true;
+        }
+    }
+    let first = std::mem::take(&mut d.iterations);
+    for (header, var, count, mut values) in loops {
+        values.sort_unstable();
+        values.dedup();
+        let mut text = match values.as_slice() {
+            // A loop of one iteration adds nothing to know.
+            _ if count == 1 => continue,
+            [v] => format!("in the iteration `{var} = {v}` of this loop"),
+            _ if values.len() as i64 == count => {
+                format!("in all {count} iterations of this loop")
+            }
+            _ => {
+                let shown: Vec<String> = values.iter().take(6).map(|v| v.to_string()).collect();
+                let more = if values.len() > 6 { ", ..." } else { "" };
+                format!(
+                    "in {} of the {count} iterations of this loop (`{var}` = {}{more})",
+                    values.len(),
+                    shown.join(", ")
+                )
+            }
+        };
+        if let (true, true, Some(f)) = (
+            shown_first,
+            values.len() > 1,
+            first.iter().find(|f| f.header == header),
+        ) {
+            text.push_str(&format!("; the message is that of `{var} = {}`", f.value));
+        }
+        d = d.at(header, text);
+    }
+    d
+}
+
+/// The message with every bracketed whole number written `[..]`: `bob[2]` -> `bob[..]`.
+fn without_indices(message: &str) -> String {
+    let mut out = String::with_capacity(message.len());
+    let mut rest = message;
+    while let Some(i) = rest.find('[') {
+        out.push_str(&rest[..i]);
+        let after = &rest[i + 1..];
+        match after.find(']') {
+            Some(j) if j > 0 && after[..j].chars().all(|c| c.is_ascii_digit() || c == '-') => {
+                out.push_str("[..]");
+                rest = &after[j + 1..];
+            }
+            _ => {
+                out.push('[');
+                rest = after;
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
 /// The closest candidate by edit distance, if it is close enough to be a likely typo.
 pub fn did_you_mean<'a>(
     name: &str,
@@ -124,6 +240,13 @@ fn edit_distance(a: &str, b: &str) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn indices_are_elided_only_where_bracketed_numbers_are() {
+        assert_eq!(without_indices("mass of `bob[12]`"), "mass of `bob[..]`");
+        assert_eq!(without_indices("[kg*m^2]"), "[kg*m^2]");
+        assert_eq!(without_indices("a[1][2] b[x] c["), "a[..][..] b[x] c[");
+    }
 
     #[test]
     fn did_you_mean_finds_close_names_only() {

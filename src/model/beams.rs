@@ -3,12 +3,12 @@
 use super::build::{add, cross, dot, norm, scale, sub, Builder, Built, View};
 use super::env::Ref;
 use super::eval::{mat_mul, rotation, Value};
-use super::units::Dim;
+use super::units::{self, Dim, Quantity};
 use super::*;
 use crate::diagnostics::{Code, Diagnostic};
 use crate::syntax::ast::{Block, PropValue};
 
-const BENDING: Dim = Dim::new(1, 3, -2);
+const BENDING: Quantity = Dim::new(1, 3, -2).quantity();
 
 impl Builder<'_> {
     pub(super) fn section_decl(&mut self, v: &View) -> Option<Built> {
@@ -29,11 +29,11 @@ impl Builder<'_> {
     }
 
     fn section(&mut self, v: &View, block: &Block, name: String) -> Option<Section> {
-        const DIAG: [(&str, Dim); 6] = [
-            ("EA", Dim::FORCE),
-            ("GA2", Dim::FORCE),
-            ("GA3", Dim::FORCE),
-            ("GJ", BENDING),
+        const DIAG: [(&str, Quantity); 6] = [
+            ("EA", units::AXIAL_STIFFNESS),
+            ("GA2", units::SHEAR_STIFFNESS),
+            ("GA3", units::SHEAR_STIFFNESS),
+            ("GJ", units::TORSIONAL_RIGIDITY),
             ("EI2", BENDING),
             ("EI3", BENDING),
         ];
@@ -233,8 +233,8 @@ impl Builder<'_> {
                 if x != 0.0 && d != dim {
                     self.error(
                         v.scope,
-                        Diagnostic::error(Code::E0202, format!("stiffness entry ({}, {}) must be a {}, found a {}", i + 1, j + 1, dim.describe(), d.describe()))
-                            .at(item.span, format!("this is a {}", d.describe()))
+                        Diagnostic::error(Code::E0202, format!("stiffness entry ({}, {}) must be {}, found {}", i + 1, j + 1, dim.describe(), d.describe()))
+                            .at(item.span, format!("this is {}", d.describe()))
                             .hint("rows and columns 1-3 are forces (N), 4-6 moments (N*m): the blocks are N, N*m and N*m^2"),
                     );
                     return None;
@@ -329,7 +329,13 @@ impl Builder<'_> {
             None => Some(3),
         };
         let twist = match self.expr(v.scope, p.get("twist")) {
-            Some(e) => self.scalar(v.scope, e, Dim::NONE, "`twist`"),
+            Some(e) => {
+                let x = self.scalar(v.scope, e, units::ANGLE, "`twist`");
+                if x.is_some() {
+                    self.angle_unit(v.scope, Some(e), x, "`twist`");
+                }
+                x
+            }
             None => Some(0.0),
         };
         let e2 = match self.expr(v.scope, p.get("e2")) {

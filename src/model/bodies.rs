@@ -535,20 +535,24 @@ impl Builder<'_> {
                 return None;
             }
         };
-        let (r, rest) = match self.env.resolve(scope, &segs, m.path.span) {
+        let (r, rest, passed) = match self.env.resolve_marker(scope, &segs, m.path.span) {
             Ok(x) => x,
             Err(d) => {
                 self.error(scope, d);
                 return None;
             }
         };
-        let offset = match &m.offset {
-            Some(e) => Some((
-                self.vector(scope, e, Dim::LENGTH, "a marker offset")?,
-                e.span,
-            )),
-            None => None,
-        };
+        // Its own offset and those of the marker arguments it names, all in one frame (the
+        // body's, the beam section's or the inertial one), so they add.
+        let mut offset: Option<([f64; 3], Span)> = None;
+        let written = m.offset.iter().map(|e| (e.clone(), scope));
+        for (e, s) in written.chain(passed) {
+            let o = self.vector(s, &e, Dim::LENGTH, "a marker offset")?;
+            offset = Some(match offset {
+                Some((sum, first)) => (add(sum, o), first),
+                None => (o, e.span),
+            });
+        }
         let not_marker = |this: &mut Self, what: String| {
             this.error(
                 scope,

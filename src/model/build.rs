@@ -5,9 +5,9 @@
 use super::elaborate::{unused_bindings, Elaborator};
 use super::env::{is_secondary, BindingKind, Env, Named, ScopeId};
 use super::eval::Value;
-use super::units::Dim;
+use super::units::{Dim, Quantity};
 use super::*;
-use crate::diagnostics::{did_you_mean, Code, Diagnostic, Sink};
+use crate::diagnostics::{did_you_mean, merge_repeats, Code, Diagnostic, Sink};
 use crate::source::SourceMap;
 use crate::syntax::ast::{self, Block, Expr, Item, MarkerRef, Prop, PropValue};
 use std::collections::HashMap;
@@ -73,8 +73,22 @@ pub(super) const KINDS: &[&str] = &[
     "concentrated_mass",
 ];
 
-/// Builds and checks the model. Every error found is pushed to `sink`; `None` if any.
+/// Builds and checks the model. Every error found is pushed to `sink`, each mistake once (a
+/// loop's repeats merged, see [`merge_repeats`]); `None` if any.
 pub fn build(
+    file: &ast::File,
+    file_name: &str,
+    overrides: &Overrides,
+    sources: &mut SourceMap,
+    loader: &dyn Loader,
+    sink: &mut Sink,
+) -> Option<Model> {
+    let model = build_model(file, file_name, overrides, sources, loader, sink);
+    sink.diagnostics = merge_repeats(std::mem::take(&mut sink.diagnostics));
+    model
+}
+
+fn build_model(
     file: &ast::File,
     file_name: &str,
     overrides: &Overrides,
@@ -172,7 +186,15 @@ pub fn build(
     }
     let outputs = b.outputs(&out.outputs);
     let exact = b.exacts(&out.exacts, &outputs);
-    let solve = b.solve(out.solve.as_ref(), overrides, top, file.span);
+    // A missing solve block is reported at the header (or where it belongs).
+    let header = match &out.header {
+        Some((_, _, span)) => *span,
+        None => Span {
+            end: file.span.start,
+            ..file.span
+        },
+    };
+    let solve = b.solve(out.solve.as_ref(), overrides, top, file.span, header);
 
     for e in std::mem::take(&mut b.env.errors) {
         b.sink.push(e);
@@ -188,6 +210,7 @@ pub fn build(
     for e in std::mem::take(&mut b.env.errors) {
         b.sink.push(e);
     }
+    b.excuse_failed(&file.items, file.span.source);
     b.unused(file.span.source, &out);
     if b.sink.has_errors() {
         return None;
@@ -320,6 +343,19 @@ impl Builder<'_> {
             }
         };
         self.built[v.decl] = built;
+    }
+
+    /// Whether a body or beam named `name`, or declared inside the instance named `name`
+    /// (`rotor`), failed to build. What needs those bodies stays silent then: their own errors
+    /// have been reported, and "declares no bodies" would be a second error for one mistake.
+    pub fn failed_within(&self, name: &str) -> bool {
+        self.env.decls.iter().enumerate().any(|(d, decl)| {
+            self.built[d].is_none()
+                && decl
+                    .item_kind()
+                    .is_some_and(|k| matches!(k, "point_mass" | "rigid" | "rigid_rod" | "beam"))
+                && (decl.name == name || decl.name.starts_with(&format!("{name}.")))
+        })
     }
 
     /// Checks the parts a declaration has against those its kind takes.
@@ -480,7 +516,7 @@ impl Builder<'_> {
         &mut self,
         scope: ScopeId,
         e: &Expr,
-        dim: Dim,
+        want: Quantity,
         what: &str,
         vector: bool,
     ) -> Option<Value> {
@@ -494,48 +530,74 @@ impl Builder<'_> {
             (Value::Scalar { .. }, true)
             | (Value::Vector { .. }, false)
             | (Value::Rotation { .. }, _) => {
-                let want = if vector {
+                let shape = if vector {
                     "a vector `(x, y, z)`"
                 } else {
                     "a scalar"
                 };
                 Diagnostic::error(
                     Code::E0209,
-                    format!("{what} must be {want}, found {}", v.kind_name()),
+                    format!("{what} must be {shape}, found {}", v.kind_name()),
                 )
                 .at(e.span, format!("this is {}", v.kind_name()))
             }
-            _ if v.dim() != dim => Diagnostic::error(
-                Code::E0202,
-                format!(
-                    "{what} must be a {}, found a {}",
-                    dim.describe(),
-                    v.dim().describe()
-                ),
-            )
-            .at(e.span, format!("this is a {}", v.dim().describe())),
+            _ if v.dim() != want.dim => self.mismatch(scope, e, want, v.dim(), what),
             _ => return Some(v),
         };
         let hint = if let Value::Signal { .. } = v {
             "only loads, prescribed motions and functions may depend on `t`".to_string()
         } else if vector && !matches!(v, Value::Vector { .. }) {
-            format!("write `(x, y, z)`; {}", unit_hint(dim))
+            format!("write `(x, y, z)`; {}", unit_hint(want, vector))
         } else {
-            unit_hint(dim)
+            unit_hint(want, vector)
         };
         self.error(scope, error.hint(hint));
         None
     }
 
-    pub fn scalar(&mut self, scope: ScopeId, e: &Expr, dim: Dim, what: &str) -> Option<f64> {
-        match self.typed(scope, e, dim, what, false)? {
+    /// E0202 for `e`, found of dimension `found` where `want` is needed: at the use, and at
+    /// the definition of the param or let it names.
+    fn mismatch(
+        &self,
+        scope: ScopeId,
+        e: &Expr,
+        want: Quantity,
+        found: Dim,
+        what: &str,
+    ) -> Diagnostic {
+        let found = found.describe();
+        let d = Diagnostic::error(
+            Code::E0202,
+            format!("{what} must be {}, found {found}", want.describe()),
+        )
+        .at(e.span, format!("this is {found}"));
+        match self.env.definition(scope, e) {
+            Some((span, how)) => d.at(span, format!("{how} as {found}")),
+            None => d,
+        }
+    }
+
+    pub fn scalar(
+        &mut self,
+        scope: ScopeId,
+        e: &Expr,
+        want: impl Into<Quantity>,
+        what: &str,
+    ) -> Option<f64> {
+        match self.typed(scope, e, want.into(), what, false)? {
             Value::Scalar { value, .. } => Some(value),
             _ => None,
         }
     }
 
-    pub fn vector(&mut self, scope: ScopeId, e: &Expr, dim: Dim, what: &str) -> Option<[f64; 3]> {
-        match self.typed(scope, e, dim, what, true)? {
+    pub fn vector(
+        &mut self,
+        scope: ScopeId,
+        e: &Expr,
+        want: impl Into<Quantity>,
+        what: &str,
+    ) -> Option<[f64; 3]> {
+        match self.typed(scope, e, want.into(), what, true)? {
             Value::Vector { value, .. } => Some(value),
             _ => None,
         }
@@ -577,29 +639,19 @@ impl Builder<'_> {
         &mut self,
         scope: ScopeId,
         e: &Expr,
-        dim: Dim,
+        want: impl Into<Quantity>,
         what: &str,
         vector: bool,
     ) -> Option<Vec<TimeFn>> {
+        let want = want.into();
         let v = self.value(scope, e)?;
         let parts = v.parts();
-        let want = if vector { 3 } else { 1 };
+        let count = if vector { 3 } else { 1 };
         match parts {
-            Some((p, d)) if p.len() == want && d == dim => Some(p),
-            Some((p, d)) if p.len() == want => {
-                self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0202,
-                        format!(
-                            "{what} must be a {}, found a {}",
-                            dim.describe(),
-                            d.describe()
-                        ),
-                    )
-                    .at(e.span, format!("this is a {}", d.describe()))
-                    .hint(unit_hint(dim)),
-                );
+            Some((p, d)) if p.len() == count && d == want.dim => Some(p),
+            Some((p, d)) if p.len() == count => {
+                let error = self.mismatch(scope, e, want, d, what);
+                self.error(scope, error.hint(unit_hint(want, vector)));
                 None
             }
             _ => {
@@ -615,7 +667,7 @@ impl Builder<'_> {
                         format!("{what} must be {shape}, found {}", v.kind_name()),
                     )
                     .at(e.span, format!("this is {}", v.kind_name()))
-                    .hint(unit_hint(dim)),
+                    .hint(unit_hint(want, vector)),
                 );
                 None
             }
@@ -652,6 +704,30 @@ impl Builder<'_> {
             return None;
         }
         Some(x as usize)
+    }
+
+    /// Marks as used every name written in a declaration of the model file that failed (the
+    /// innermost item holding a label of an error): a param whose only user failed was not
+    /// forgotten, and "never used" would be a second report of one mistake.
+    fn excuse_failed(&mut self, items: &[Item], main: crate::source::SourceId) {
+        let spans: Vec<Span> = self
+            .sink
+            .diagnostics
+            .iter()
+            .filter(|d| d.is_error())
+            .flat_map(|d| d.labels.iter().map(|l| l.span))
+            .filter(|s| s.source == main)
+            .collect();
+        if spans.is_empty() {
+            return;
+        }
+        let mut names = std::collections::HashSet::new();
+        failed_names(items, &spans, &mut names);
+        for b in &mut self.env.bindings {
+            if b.span.source == main && names.contains(&b.name) {
+                b.used = true;
+            }
+        }
     }
 
     /// Warnings for what the model file declares and never uses.
@@ -720,22 +796,66 @@ impl Builder<'_> {
     }
 }
 
-pub(super) fn unit_hint(dim: Dim) -> String {
-    let example = match (dim.mass, dim.length, dim.time) {
-        (1, 0, 0) => "`1.0 kg`",
-        (0, 1, 0) => "`0.5 m` or `(0, -0.5, 0) m`",
-        (0, 0, 1) => "`0.005 s`",
-        (0, 1, -1) => "`1.5 m/s` or `(1.5, 0, 0) m/s`",
-        (0, 1, -2) => "`(0, -9.81, 0) m/s^2`",
-        (0, 0, -1) => "`98.17 rad/s`",
-        (1, 1, -2) => "`20 N` or `(20, 0, 0) N`",
-        (1, 2, -2) => "`14 N*m` (or `14 N*m/rad` for a torsional stiffness)",
-        (1, 0, -2) => "`15434 N/m`",
-        (1, 2, 0) => "`48.6 kg*m^2`",
-        (0, 0, 0) => "a plain number",
-        _ => "a value with units",
+/// Collects the names written in the innermost items that contain one of `spans`; whether
+/// any item did.
+fn failed_names(
+    items: &[Item],
+    spans: &[Span],
+    names: &mut std::collections::HashSet<String>,
+) -> bool {
+    let mut any = false;
+    for item in items {
+        let outer = item.span();
+        if !spans
+            .iter()
+            .any(|s| outer.start <= s.start && s.end <= outer.end)
+        {
+            continue;
+        }
+        any = true;
+        let inside = match item {
+            Item::For { items, .. } => failed_names(items, spans, names),
+            Item::If {
+                then, otherwise, ..
+            } => failed_names(then, spans, names) | failed_names(otherwise, spans, names),
+            Item::Component(c) => failed_names(&c.items, spans, names),
+            _ => false,
+        };
+        if !inside {
+            names.extend(written_names(item));
+        }
+    }
+    any
+}
+
+/// Every name an item writes (declared or used), read from its syntax tree.
+pub(super) fn written_names(item: &Item) -> Vec<String> {
+    let Ok(text) = serde_json::to_string(item) else {
+        return Vec::new();
     };
-    format!("expected a {}, e.g. {example}", dim.describe())
+    text.split("\"name\":\"")
+        .skip(1)
+        .filter_map(|part| part.split('"').next())
+        .map(str::to_string)
+        .collect()
+}
+
+/// "expected a length [m], e.g. `0.5 m`" (a vector of it: "`(0, 0, 0.5) m`").
+pub(super) fn unit_hint(want: Quantity, vector: bool) -> String {
+    let example = match (vector, want.dim.is_none()) {
+        (false, _) => want.example(),
+        (true, true) => "`(1, 0, 0)`".to_string(),
+        (true, false) => {
+            let e = want.example();
+            // `0.5 m` -> `(0, 0, 0.5) m`
+            let inner = e.trim_matches('`');
+            match inner.split_once(' ') {
+                Some((x, unit)) => format!("`(0, 0, {x}) {unit}`"),
+                None => format!("`(0, 0, {inner})`"),
+            }
+        }
+    };
+    format!("expected {}, e.g. {example}", want.describe())
 }
 
 pub(super) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

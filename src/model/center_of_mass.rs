@@ -131,6 +131,10 @@ impl Builder<'_> {
                 },
                 Member::Instance(s) => {
                     let prefix = self.env.scopes[s].prefix.clone();
+                    if self.failed_within(prefix.trim_end_matches('.')) {
+                        // Its bodies' errors have been reported.
+                        return None;
+                    }
                     let inside = |name: &str| name.starts_with(&prefix);
                     for (i, &d) in self.body_decl.iter().enumerate() {
                         if inside(&self.env.decls[d].name) {

@@ -1,13 +1,12 @@
 //! Joints, springs and dampers, loads, and initial motion.
 
 use super::build::{add, cross, dot, norm, scale, sub, Builder, Built, View};
-use super::env::Ref;
-use super::units::Dim;
+use super::env::{Member, Ref};
+use super::units::{self, Dim, Quantity};
 use super::*;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
 use crate::syntax::ast::{Item, MarkerRef};
 
-const TORQUE: Dim = Dim::new(1, 2, -2);
 const RATE: Dim = Dim::new(0, 0, -1);
 
 /// The joint kinds, for "did you mean".
@@ -21,7 +20,29 @@ const JOINTS: &[&str] = &[
     "distance",
 ];
 
+/// A property's expression, if it is one (not a block).
+fn prop_expr(p: &crate::syntax::ast::Prop) -> Option<&crate::syntax::ast::Expr> {
+    match &p.value {
+        crate::syntax::ast::PropValue::Expr(e) => Some(e),
+        crate::syntax::ast::PropValue::Block(_) => None,
+    }
+}
+
 impl Builder<'_> {
+    /// W0203 if the angle `e` of `what` is a bare number (`value`: its constant value, `None`
+    /// for a function of time).
+    pub(super) fn angle_unit(
+        &mut self,
+        scope: usize,
+        e: Option<&crate::syntax::ast::Expr>,
+        value: Option<f64>,
+        what: &str,
+    ) {
+        if let Some(d) = e.and_then(|e| self.env.bare_angle(scope, e, value, what)) {
+            self.error(scope, d);
+        }
+    }
+
     /// Resolves the two markers of a connection and rejects one that connects nothing.
     fn pair(
         &mut self,
@@ -162,11 +183,13 @@ impl Builder<'_> {
             }
             true
         };
-        let scalar = |this: &mut Self, key: &str, dim: Dim| match this.expr(scope, p.get(key)) {
+        let scalar = |this: &mut Self, key: &str, dim: Quantity| match this.expr(scope, p.get(key))
+        {
             Some(e) => this.scalar(scope, e, dim, &format!("`{key}`")),
             None => Some(0.0),
         };
-        let signal = |this: &mut Self, key: &str, dim: Dim| match this.expr(scope, p.get(key)) {
+        let signal = |this: &mut Self, key: &str, dim: Quantity| match this.expr(scope, p.get(key))
+        {
             Some(e) => this
                 .signal(scope, e, dim, &format!("`{key}`"), false)
                 .map(|mut v| Some(v.remove(0))),
@@ -179,15 +202,23 @@ impl Builder<'_> {
                 if !coincide(self, if rev { None } else { Some(n) }) {
                     return;
                 }
-                let (kdim, cdim, qdim) = if rev {
-                    (TORQUE, Dim::new(1, 2, -1), Dim::NONE)
+                let (kdim, cdim, qdim): (Quantity, Quantity, Quantity) = if rev {
+                    (
+                        units::TORSIONAL_STIFFNESS,
+                        Dim::new(1, 2, -1).into(),
+                        units::ANGLE,
+                    )
                 } else {
-                    (Dim::new(1, 0, -2), Dim::new(1, 0, -1), Dim::LENGTH)
+                    (
+                        Dim::new(1, 0, -2).into(),
+                        Dim::new(1, 0, -1).into(),
+                        Dim::LENGTH.into(),
+                    )
                 };
                 let spring = scalar(self, "spring", kdim);
                 let damper = scalar(self, "damper", cdim);
                 let rest = if rev {
-                    scalar(self, "rest_angle", Dim::NONE)
+                    scalar(self, "rest_angle", units::ANGLE)
                 } else {
                     Some(0.0)
                 };
@@ -197,8 +228,16 @@ impl Builder<'_> {
                     ("displacement", "speed", "force")
                 };
                 let position = signal(self, pos_key, qdim);
-                let rate = signal(self, rate_key, qdim.over(Dim::TIME));
-                let load = signal(self, load_key, if rev { TORQUE } else { Dim::FORCE });
+                let rate = signal(self, rate_key, qdim.dim.over(Dim::TIME).into());
+                let load = signal(
+                    self,
+                    load_key,
+                    if rev {
+                        units::TORQUE
+                    } else {
+                        Dim::FORCE.into()
+                    },
+                );
                 let (
                     Some(spring),
                     Some(damper),
@@ -210,6 +249,13 @@ impl Builder<'_> {
                 else {
                     return;
                 };
+                if rev {
+                    let rest_expr = p.get("rest_angle").and_then(|q| prop_expr(q));
+                    self.angle_unit(scope, rest_expr, Some(rest), "`rest_angle`");
+                    let f = position.as_ref().map(|f| f.as_constant());
+                    let angle_expr = p.get("angle").and_then(|q| prop_expr(q));
+                    self.angle_unit(scope, angle_expr, f.flatten(), "the prescribed `angle`");
+                }
                 let drives: Vec<&str> = [
                     (pos_key, position.is_some()),
                     (rate_key, rate.is_some()),
@@ -376,12 +422,12 @@ impl Builder<'_> {
         };
         let p = self.props(v.scope, v.block.as_ref(), known, &format!("a {k}"));
         let pair = self.pair(v.scope, k, &v.name, &v.markers, v.span);
-        let (kdim, cdim) = if torsional {
-            (TORQUE, Dim::new(1, 2, -1))
+        let (kdim, cdim): (Quantity, Quantity) = if torsional {
+            (units::TORSIONAL_STIFFNESS, Dim::new(1, 2, -1).into())
         } else {
-            (Dim::new(1, 0, -2), Dim::new(1, 0, -1))
+            (Dim::new(1, 0, -2).into(), Dim::new(1, 0, -1).into())
         };
-        let get = |this: &mut Self, key: &str, dim: Dim, required: bool| match this
+        let get = |this: &mut Self, key: &str, dim: Quantity, required: bool| match this
             .expr(v.scope, p.get(key))
         {
             Some(e) => this.scalar(v.scope, e, dim, &format!("`{key}`")),
@@ -468,8 +514,12 @@ impl Builder<'_> {
         }
         let (on, value) = (v.on.clone()?, v.value.clone()?);
         let marker = self.marker(v.scope, &on);
-        let dim = if k == "force" { Dim::FORCE } else { TORQUE };
-        let parts = self.signal(v.scope, &value, dim, &format!("a {k}"), true);
+        let dim = if k == "force" {
+            Dim::FORCE.into()
+        } else {
+            units::TORQUE
+        };
+        let parts = self.signal(v.scope, &value, dim, &format!("{k} `{}`", v.name), true);
         let (marker, parts) = (marker?, parts?);
         if let Attach::Ground { .. } = marker.attach {
             self.error(
@@ -497,7 +547,8 @@ impl Builder<'_> {
     }
 
     /// `initial spin of PATH = rate about AXIS through POINT`, `initial velocity of PATH = v`:
-    /// adds a rigid motion to every body and beam node of an instance, or to one body.
+    /// adds a rigid motion to every body and beam node of an instance, to one body or beam, or
+    /// to every member of a family of them (`blade`, declared in a loop).
     pub(super) fn initial(&mut self, item: &Item, scope: usize) {
         let Item::Initial {
             what,
@@ -532,27 +583,40 @@ impl Builder<'_> {
             Ok(s) => s,
             Err(d) => return self.error(scope, d),
         };
-        let prefix = match self.env.resolve(scope, &segs, target.span) {
-            Ok((Ref::Instance(s), rest)) if rest.is_empty() => self.env.scopes[s].prefix.clone(),
-            Ok((Ref::Decl(d), rest))
-                if rest.is_empty()
-                    && matches!(self.built[d], Some(Built::Body(_)) | Some(Built::Beam(_))) =>
-            {
-                self.env.decls[d].name.clone()
-            }
-            Ok(_) => {
-                return self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0222,
-                        "initial motion applies to a body, a beam or a component instance",
-                    )
-                    .at(target.span, "not a body, beam or instance")
-                    .hint("name a body (`hub`), a beam, or an instance (`rotor`)"),
+        // What it moves: a body, a beam, an instance, or every member of a family of them.
+        let not_movable = |this: &mut Self| {
+            this.error(
+                scope,
+                Diagnostic::error(
+                    Code::E0222,
+                    "initial motion applies to a body, a beam or a component instance",
                 )
-            }
+                .at(target.span, "not a body, beam or instance")
+                .hint("name a body (`hub`), a beam, an instance (`rotor`), or a family of them (`blade`)"),
+            )
+        };
+        let members = match self.env.resolve_family(scope, &segs, target.span) {
+            Ok((_, rest)) if !rest.is_empty() => return not_movable(self),
+            Ok((Ref::Instance(s), _)) => vec![Member::Instance(s)],
+            Ok((Ref::Decl(d), _)) => vec![Member::Decl(d)],
+            Ok((Ref::Family(m), _)) => m.into_iter().map(|x| x.1).collect(),
+            Ok(_) => return not_movable(self),
             Err(d) => return self.error(scope, d),
         };
+        let mut prefixes = Vec::new();
+        for m in members {
+            match m {
+                Member::Instance(s) => prefixes.push(self.env.scopes[s].prefix.clone()),
+                Member::Decl(d)
+                    if matches!(self.built[d], Some(Built::Body(_)) | Some(Built::Beam(_))) =>
+                {
+                    prefixes.push(self.env.decls[d].name.clone())
+                }
+                // A body that failed to build: its error has been reported.
+                Member::Decl(d) if self.failed_within(&self.env.decls[d].name) => return,
+                Member::Decl(_) => return not_movable(self),
+            }
+        }
         let (w, v, p) = if spin {
             let rate = self.scalar(scope, value, RATE, "the spin rate");
             let axis = match about {
@@ -590,9 +654,11 @@ impl Builder<'_> {
             ([0.0; 3], v, [0.0; 3])
         };
         let inside = |name: &str| {
-            name == prefix
-                || (prefix.ends_with('.') && name.starts_with(&prefix))
-                || name.starts_with(&format!("{prefix}."))
+            prefixes.iter().any(|prefix| {
+                name == prefix
+                    || (prefix.ends_with('.') && name.starts_with(prefix.as_str()))
+                    || name.starts_with(&format!("{prefix}."))
+            })
         };
         let mut moved = 0;
         for i in 0..self.bodies.len() {
@@ -618,7 +684,10 @@ impl Builder<'_> {
                 moved += 1;
             }
         }
-        if moved == 0 {
+        let failed = prefixes
+            .iter()
+            .any(|p| self.failed_within(p.trim_end_matches('.')));
+        if moved == 0 && !failed {
             self.error(
                 scope,
                 Diagnostic::error(Code::E0222, "this initial motion moves no body")

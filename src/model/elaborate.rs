@@ -8,7 +8,7 @@
 use super::env::{Binding, BindingKind, Decl, Env, Named, ScopeId};
 use super::types::ParamType;
 use super::{LoadRequest, Loader};
-use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::diagnostics::{did_you_mean, Code, Diagnostic, Iteration};
 use crate::source::{SourceMap, Span};
 use crate::syntax::ast::{Component, Ident, Item, OutputItem, UseTarget};
 use std::collections::{HashMap, HashSet};
@@ -163,14 +163,8 @@ impl<'a> Elaborator<'a> {
     /// Marks the names an untaken `if` branch mentions as used, so a param used only there is
     /// not reported unused.
     fn mention(&mut self, items: &[Item], scope: ScopeId) {
-        let Ok(text) = serde_json::to_string(items) else {
-            return;
-        };
-        for part in text.split("\"name\":\"").skip(1) {
-            let Some(name) = part.split('"').next() else {
-                continue;
-            };
-            if let Some(Named::Binding(id)) = self.env.lookup(scope, name) {
+        for name in items.iter().flat_map(super::build::written_names) {
+            if let Some(Named::Binding(id)) = self.env.lookup(scope, &name) {
                 self.env.bindings[id].used = true;
             }
         }
@@ -435,10 +429,20 @@ impl<'a> Elaborator<'a> {
                             )),
                     );
                 }
+                let header = Span {
+                    end: to.span.end,
+                    ..*span
+                };
                 for i in a..end {
                     let home = self.env.scopes[scope].home;
                     let prefix = self.env.scopes[home].prefix.clone();
                     let inner = self.env.new_scope(Some(scope), prefix, Some(home));
+                    self.env.scopes[inner].iteration = Some(Iteration {
+                        header,
+                        var: var.name.clone(),
+                        value: i,
+                        count: end - a,
+                    });
                     let v = super::eval::Value::scalar(i as f64, super::units::Dim::NONE);
                     let mut b = Env::binding(
                         var,
@@ -534,19 +538,32 @@ impl<'a> Elaborator<'a> {
         scope: ScopeId,
         file: &str,
     ) {
+        let index = match &name.index {
+            Some(e) => match self.env.integer_in(scope, e, "an index") {
+                Ok(i) => Some(i),
+                Err(d) => return self.error(scope, d),
+            },
+            None => None,
+        };
         let (def, def_scope) = match self.env.lookup(scope, &component.name) {
             Some(Named::Component(c, s)) => (c, s),
             Some(_) => {
+                self.failed_instance(name, index, scope);
                 return self.error(
                     scope,
                     Diagnostic::error(Code::E0222, format!("`{}` is not a component", component.name))
                         .at(component.span, "not a component")
                         .hint("instantiate a component declared with `component NAME(...) { ... }` or imported with `use`"),
-                )
+                );
             }
             None => {
+                self.failed_instance(name, index, scope);
                 let candidates = self.env.visible(scope);
-                let d = Diagnostic::error(Code::E0201, format!("unknown component `{}`", component.name)).at(component.span, "not declared");
+                let d = Diagnostic::error(
+                    Code::E0201,
+                    format!("unknown component `{}`", component.name),
+                )
+                .at(component.span, "not declared");
                 let hint = match did_you_mean(&component.name, candidates.iter().map(|s| s.as_str())) {
                     Some(s) => format!("did you mean `{s}`?"),
                     None => "declare it with `component`, or import it, e.g. `use stdlib::rotor::lag_hinged_rotor`".to_string(),
@@ -563,13 +580,6 @@ impl<'a> Elaborator<'a> {
             );
         }
         self.out.instantiated.insert(def.span);
-        let index = match &name.index {
-            Some(e) => match self.env.integer_in(scope, e, "an index") {
-                Ok(i) => Some(i),
-                Err(d) => return self.error(scope, d),
-            },
-            None => None,
-        };
         let prefix = format!("{}.", self.env.qualified(scope, &name.ident.name, index));
         let inst = self.env.new_scope(Some(def_scope), prefix, None);
         self.env.scopes[inst].instance = Some((def.name.name.clone(), span));
@@ -616,9 +626,9 @@ impl<'a> Elaborator<'a> {
             let Some(ty) = ParamType::parse(&p.ty.name) else {
                 continue;
             };
-            let (expr, eval_scope) = match (given.get(p.name.name.as_str()), &p.default) {
-                (Some(a), _) => (a.value.clone(), scope),
-                (None, Some(d)) => (d.clone(), inst),
+            let (expr, offset, eval_scope) = match (given.get(p.name.name.as_str()), &p.default) {
+                (Some(a), _) => (a.value.clone(), a.offset.clone(), scope),
+                (None, Some(d)) => (d.clone(), None, inst),
                 (None, None) => {
                     self.error(
                         scope,
@@ -655,6 +665,27 @@ impl<'a> Elaborator<'a> {
                 );
                 continue;
             }
+            if let (Some(o), false) = (&offset, ty == ParamType::Marker) {
+                self.error(
+                    scope,
+                    Diagnostic::error(
+                        Code::E0215,
+                        format!(
+                            "argument `{}` of `{}` is a {}: it takes no offset",
+                            p.name.name,
+                            def.name.name,
+                            ty.name()
+                        ),
+                    )
+                    .at(o.span, "an offset")
+                    .at(p.ty.span, "declared here")
+                    .hint(format!(
+                        "only `marker` arguments take `@ (x, y, z)`; {}",
+                        ty.example()
+                    )),
+                );
+                continue;
+            }
             let mut b = Env::binding(
                 &p.name,
                 p.span,
@@ -665,6 +696,7 @@ impl<'a> Elaborator<'a> {
                 None,
             );
             b.component = Some(def.name.name.clone());
+            b.offset = offset;
             // Arguments are part of a component's interface: never reported unused.
             b.used = true;
             let id = self.env.add_binding(b);
@@ -702,6 +734,23 @@ impl<'a> Elaborator<'a> {
                 }
             }
         }
+    }
+
+    /// Declares an instance that could not be made, so that the names through it stay silent
+    /// instead of each reporting it unknown.
+    fn failed_instance(
+        &mut self,
+        name: &crate::syntax::ast::Name,
+        index: Option<i64>,
+        scope: ScopeId,
+    ) {
+        let prefix = format!("{}.", self.env.qualified(scope, &name.ident.name, index));
+        let inst = self.env.new_scope(None, prefix, None);
+        self.env.scopes[inst].failed = true;
+        // A clash with another name is secondary to the failure reported.
+        let _ = self
+            .env
+            .declare(scope, &name.ident, index, Named::Instance(inst));
     }
 
     fn import(&mut self, target: &UseTarget, span: Span, scope: ScopeId, file: &str) {

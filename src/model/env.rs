@@ -1,4 +1,4 @@
-//! Scopes, bindings and name resolution.
+//! Scopes, bindings and their evaluation; paths are resolved in `resolve.rs`.
 //!
 //! A scope holds names: value bindings (params, lets, functions, component arguments, loop
 //! variables), declarations, indexed families of them (`blade[0..4]`), component instances and
@@ -13,7 +13,7 @@
 use super::eval::{eval, Names, Value};
 use super::types::ParamType;
 use super::units::Dim;
-use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::diagnostics::{Code, Diagnostic, Iteration};
 use crate::runtime::timefn::TimeFn;
 use crate::source::Span;
 use crate::syntax::ast::{Component, Expr, ExprKind, Ident, Item, Path, PropValue};
@@ -23,6 +23,8 @@ use std::rc::Rc;
 pub type ScopeId = usize;
 pub type DeclId = usize;
 pub type BindingId = usize;
+/// The offset of a marker argument and the scope it is evaluated in.
+pub type Offset = (Expr, ScopeId);
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Member {
@@ -56,6 +58,11 @@ pub struct Scope {
     pub instance: Option<(String, Span)>,
     /// For an instance scope: the scope of the code that instantiated it.
     pub caller: Option<ScopeId>,
+    /// For the scope of one iteration of a `for` loop: which one.
+    pub iteration: Option<Iteration>,
+    /// For an instance scope: the instance could not be made (unknown component, too deep), so
+    /// what names it stays silent; the cause has been reported.
+    pub failed: bool,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -87,6 +94,9 @@ pub struct Binding {
     pub ty: Option<(ParamType, Span)>,
     /// For a component argument: the component it belongs to (for messages).
     pub component: Option<String>,
+    /// For a marker argument written with an offset (`base = earth @ (0, 0, 1) m`): the
+    /// offset, evaluated in `scope` when the marker is resolved.
+    pub offset: Option<Expr>,
     state: State,
     pub used: bool,
 }
@@ -138,7 +148,7 @@ pub enum Ref {
 
 const BUILTINS: &[&str] = &["t", "pi", "x", "y", "z", "true", "false"];
 
-fn builtin(name: &str) -> Option<Value> {
+pub(super) fn builtin(name: &str) -> Option<Value> {
     let unit = |k: usize| {
         let mut v = [0.0; 3];
         v[k] = 1.0;
@@ -170,10 +180,13 @@ pub struct Env {
     /// Errors found while evaluating on demand.
     pub errors: Vec<Diagnostic>,
     /// Nesting of on-demand evaluations, to stop runaway self-reference.
-    depth: usize,
+    pub(super) depth: usize,
     /// Set by [`Env::resolve_family`]: a family named without an index resolves to
     /// [`Ref::Family`] instead of asking for an index.
-    families: bool,
+    pub(super) families: bool,
+    /// Set by [`Env::resolve_marker`]: the offsets of the marker arguments resolution passes
+    /// through, each with the scope it is evaluated in.
+    pub(super) offsets: Option<Vec<Offset>>,
 }
 
 impl Env {
@@ -193,6 +206,8 @@ impl Env {
             exports: None,
             instance: None,
             caller: None,
+            iteration: None,
+            failed: false,
         });
         id
     }
@@ -307,6 +322,7 @@ impl Env {
             set: None,
             ty,
             component: None,
+            offset: None,
             state: match value {
                 Some(v) => State::Done(v),
                 None => State::Pending,
@@ -347,11 +363,15 @@ impl Env {
         }
     }
 
-    /// "in this instance of component X" notes for a diagnostic raised in `scope`.
+    /// "in this instance of component X" notes for a diagnostic raised in `scope`, and the loop
+    /// iterations it was raised in (labels once repeats are merged).
     pub fn trace(&self, scope: ScopeId, mut d: Diagnostic) -> Diagnostic {
         let mut s = Some(scope);
         let mut n = 0;
         while let Some(id) = s {
+            if let Some(it) = &self.scopes[id].iteration {
+                d.iterations.push(it.clone());
+            }
             if let Some((comp, span)) = &self.scopes[id].instance {
                 if n < 4 && !d.labels.iter().any(|l| l.span == *span) {
                     d = d.at(*span, format!("in this instance of component `{comp}`"));
@@ -380,8 +400,45 @@ impl Env {
         match self.eval_in(scope, expr)? {
             Value::Scalar { value, dim } if dim.is_none() && value.fract() == 0.0 && value.abs() < 1e9 => Ok(value as i64),
             v => Err(Diagnostic::error(Code::E0214, format!("{what} must be a whole number"))
-                .at(expr.span, format!("this is {} {}", v.kind_name(), if v.dim().is_none() { String::new() } else { v.dim().describe() }))
+                .at(expr.span, match &v { Value::Scalar { value, dim } if dim.is_none() => format!("this is {value}"), Value::Scalar { dim, .. } => format!("this is {}", dim.describe()), v => format!("this is {}", v.kind_name()) })
                 .hint("indices and loop bounds are dimensionless integers, e.g. `blade[i]` with `for i in 0..N`")),
+        }
+    }
+
+    /// Where the value of `e` was defined, when `e` names a param, a let or a function (the
+    /// declaration) or a component argument (the value given to the instance, or what that
+    /// names in turn): a second place to look when the value is wrong where it is used.
+    pub fn definition(&self, scope: ScopeId, e: &Expr) -> Option<(Span, &'static str)> {
+        self.definition_at(scope, e, 0)
+    }
+
+    fn definition_at(
+        &self,
+        scope: ScopeId,
+        e: &Expr,
+        depth: usize,
+    ) -> Option<(Span, &'static str)> {
+        let ExprKind::Path { path } = &e.kind else {
+            return None;
+        };
+        let Some(Named::Binding(id)) = self.lookup(scope, &path.single()?.name) else {
+            return None;
+        };
+        let b = &self.bindings[id];
+        match b.kind {
+            BindingKind::Param | BindingKind::Let | BindingKind::Function => {
+                Some((b.span, "defined here"))
+            }
+            BindingKind::Arg => {
+                let given = b.expr.as_ref()?;
+                let further = if depth < 8 {
+                    self.definition_at(b.scope, given, depth + 1)
+                } else {
+                    None
+                };
+                further.or(Some((given.span, "given here")))
+            }
+            BindingKind::LoopVar => None,
         }
     }
 
@@ -465,8 +522,8 @@ impl Env {
                     g if g.dim().is_none() && !v.dim().is_none() => Ok(g.with_dim(v.dim())),
                     g if g.dim() == v.dim() && std::mem::discriminant(&g) == std::mem::discriminant(&v) => Ok(g),
                     g => Err(Diagnostic::error(Code::E0202, format!("`--set {name}` has the wrong dimension"))
-                        .at(set.span, format!("this is a {}", g.dim().describe()))
-                        .hint(format!("`{name}` is a {}; give a plain number in SI units or a value with matching units", v.dim().describe()))),
+                        .at(set.span, format!("this is {}", g.dim().describe()))
+                        .hint(format!("`{name}` is {}; give a plain number in SI units or a value with matching units", v.dim().describe()))),
                 };
             }
         }
@@ -474,13 +531,31 @@ impl Env {
             if let Err(found) = ty.accepts(&v) {
                 let comp = b.component.clone().unwrap_or_default();
                 let name = b.name.clone();
-                return Err(Diagnostic::error(
+                let mut d = Diagnostic::error(
                     Code::E0215,
                     format!("argument `{name}` of `{comp}` must be {}", ty.describe()),
                 )
-                .at(expr.span, format!("this is {found}"))
-                .at(tspan, "declared here")
-                .hint(ty.example()));
+                .at(expr.span, format!("this is {found}"));
+                if let Some((span, how)) = self.definition(b.scope, expr) {
+                    d = d.at(span, format!("{how} as {found}"));
+                }
+                return Err(d
+                    .at(tspan, format!("declared here as `{name}: {}`", ty.name()))
+                    .hint(ty.example()));
+            }
+            if let (ParamType::Scalar(q), Value::Scalar { value, .. }) = (ty, &v) {
+                if q == super::units::ANGLE {
+                    let what = format!(
+                        "argument `{}` of `{}`",
+                        b.name,
+                        b.component.clone().unwrap_or_default()
+                    );
+                    let scope = b.scope;
+                    if let Some(d) = self.bare_angle(scope, expr, Some(*value), &what) {
+                        let d = self.trace(scope, d);
+                        self.errors.push(d);
+                    }
+                }
             }
             if let ParamType::Direction = ty {
                 if let Value::Vector { value, .. } = v {
@@ -494,282 +569,6 @@ impl Env {
             }
         }
         Ok(v)
-    }
-
-    /// Evaluates the index and argument expressions of a path in `scope`.
-    pub fn segs(&mut self, scope: ScopeId, path: &Path) -> Result<Vec<Seg>, Diagnostic> {
-        let mut out = Vec::with_capacity(path.segments.len());
-        for s in &path.segments {
-            let index = match &s.index {
-                Some(e) => Some((self.integer_in(scope, e, "an index")?, e.span)),
-                None => None,
-            };
-            let arg = match &s.arg {
-                Some(e) => Some((self.eval_in(scope, e)?, e.span)),
-                None => None,
-            };
-            out.push(Seg {
-                name: s.name.clone(),
-                index,
-                arg,
-                span: s.span,
-            });
-        }
-        Ok(out)
-    }
-
-    /// Resolves a path to what it names, returning the segments left over (a property, a
-    /// marker, a quantity). Follows component arguments of reference type and export aliases.
-    pub fn resolve(
-        &mut self,
-        scope: ScopeId,
-        segs: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        self.depth += 1;
-        if self.depth > 64 {
-            self.depth -= 1;
-            return Err(
-                Diagnostic::error(Code::E0207, "this reference refers back to itself")
-                    .at(span, "resolving this never ends")
-                    .hint("an argument or export alias names itself, directly or through others"),
-            );
-        }
-        let r = self.resolve_inner(scope, segs, span);
-        self.depth -= 1;
-        r
-    }
-
-    /// Like [`Env::resolve`], but a family named without an index (`rotor.lag`) is a
-    /// [`Ref::Family`], for output functions that take every member.
-    pub fn resolve_family(
-        &mut self,
-        scope: ScopeId,
-        segs: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let was = std::mem::replace(&mut self.families, true);
-        let r = self.resolve(scope, segs, span);
-        self.families = was;
-        r
-    }
-
-    fn resolve_inner(
-        &mut self,
-        scope: ScopeId,
-        segs: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let Some(head) = segs.first() else {
-            return Err(Diagnostic::error(Code::E0201, "empty path").at(span, "here"));
-        };
-        let named = match self.lookup(scope, &head.name.name) {
-            Some(n) => n,
-            None => {
-                if let (Some(v), None) = (builtin(&head.name.name), head.index) {
-                    return Ok((Ref::Builtin(v), segs[1..].to_vec()));
-                }
-                let candidates = self.visible(scope);
-                let d =
-                    Diagnostic::error(Code::E0201, format!("unknown name `{}`", head.name.name))
-                        .at(head.name.span, "not declared");
-                return Err(match did_you_mean(&head.name.name, candidates.iter().map(|s| s.as_str())) {
-                    Some(s) => d.hint(format!("did you mean `{s}`?")),
-                    None => d.hint("declare it (`param`, `let`, a body, a joint, ...) or import it with `use`; names are case-sensitive"),
-                });
-            }
-        };
-        self.follow(named, head, &segs[1..], span)
-    }
-
-    /// Continues resolution from `named` (reached by segment `seg`) with the segments `rest`.
-    fn follow(
-        &mut self,
-        named: Named,
-        seg: &Seg,
-        rest: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let name = &seg.name.name;
-        let not_indexed = |what: &str| {
-            Diagnostic::error(
-                Code::E0214,
-                format!("`{name}` is {what}, not an indexed family"),
-            )
-            .at(
-                seg.index.map(|i| i.1).unwrap_or(seg.span),
-                "index given here",
-            )
-            .hint(format!("write `{name}` without an index"))
-        };
-        let r = match named {
-            Named::Binding(b) => {
-                if seg.index.is_some() {
-                    return Err(not_indexed("a value"));
-                }
-                let is_ref = self.bindings[b]
-                    .ty
-                    .as_ref()
-                    .map(|t| t.0.is_reference())
-                    .unwrap_or(false);
-                if is_ref {
-                    // A marker or body argument: resolve what the caller wrote, in the caller's scope.
-                    self.bindings[b].used = true;
-                    let (expr, bscope) = (self.bindings[b].expr.clone(), self.bindings[b].scope);
-                    let Some(Expr {
-                        kind: ExprKind::Path { path },
-                        ..
-                    }) = expr
-                    else {
-                        return Err(secondary(span));
-                    };
-                    let mut segs = self.segs(bscope, &path)?;
-                    segs.extend_from_slice(rest);
-                    return self.resolve(bscope, &segs, span);
-                }
-                Ref::Binding(b)
-            }
-            Named::Decl(d) => {
-                if seg.index.is_some() {
-                    return Err(not_indexed("a single declaration"));
-                }
-                self.decls[d].used = true;
-                Ref::Decl(d)
-            }
-            Named::Component(c, _) => Ref::Component(c),
-            Named::Instance(s) => {
-                if seg.index.is_some() {
-                    return Err(not_indexed("a single instance"));
-                }
-                return self.enter_instance(s, rest, span);
-            }
-            Named::Family(map) => {
-                if seg.index.is_none() && self.families {
-                    for m in map.values() {
-                        if let Member::Decl(d) = m {
-                            self.decls[*d].used = true;
-                        }
-                    }
-                    return Ok((Ref::Family(map.into_iter().collect()), rest.to_vec()));
-                }
-                let Some((i, ispan)) = seg.index else {
-                    let (lo, hi) = (
-                        map.keys().next().copied().unwrap_or(0),
-                        map.keys().last().copied().unwrap_or(0),
-                    );
-                    return Err(Diagnostic::error(
-                        Code::E0214,
-                        format!("`{name}` is an indexed family; say which one"),
-                    )
-                    .at(seg.span, "no index")
-                    .hint(format!("write `{name}[i]` with i in {lo}..={hi}")));
-                };
-                match map.get(&i) {
-                    Some(Member::Decl(d)) => {
-                        self.decls[*d].used = true;
-                        Ref::Decl(*d)
-                    }
-                    Some(Member::Instance(s)) => return self.enter_instance(*s, rest, span),
-                    None => {
-                        let keys: Vec<i64> = map.keys().copied().collect();
-                        let range = match (keys.first(), keys.last()) {
-                            (Some(a), Some(b)) if (b - a + 1) as usize == keys.len() => {
-                                format!("{a}..={b}")
-                            }
-                            _ => keys
-                                .iter()
-                                .map(|k| k.to_string())
-                                .collect::<Vec<_>>()
-                                .join(", "),
-                        };
-                        return Err(Diagnostic::error(
-                            Code::E0214,
-                            format!("index {i} is out of range for `{name}`"),
-                        )
-                        .at(ispan, "no such member")
-                        .hint(format!("`{name}` has indices {range}")));
-                    }
-                }
-            }
-        };
-        Ok((r, rest.to_vec()))
-    }
-
-    /// Resolves the segments after an instance name, honouring its exports.
-    fn enter_instance(
-        &mut self,
-        s: ScopeId,
-        rest: &[Seg],
-        span: Span,
-    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let Some(next) = rest.first() else {
-            return Ok((Ref::Instance(s), Vec::new()));
-        };
-        let key = next.name.name.clone();
-        if let Some(exports) = &self.scopes[s].exports {
-            match exports.get(&key) {
-                None => {
-                    let comp = self.scopes[s]
-                        .instance
-                        .clone()
-                        .map(|i| i.0)
-                        .unwrap_or_default();
-                    let mut names: Vec<&String> = exports.keys().collect();
-                    names.sort();
-                    let list = names
-                        .iter()
-                        .map(|n| n.as_str())
-                        .collect::<Vec<_>>()
-                        .join(", ");
-                    let code = if self.scopes[s].names.contains_key(&key) {
-                        Code::E0219
-                    } else {
-                        Code::E0201
-                    };
-                    let d = Diagnostic::error(
-                        code,
-                        format!("component `{comp}` does not export `{key}`"),
-                    )
-                    .at(next.name.span, "not exported");
-                    return Err(match did_you_mean(&key, names.iter().map(|n| n.as_str())) {
-                        Some(m) => d.hint(format!("did you mean `{m}`? It exports: {list}")),
-                        None => d.hint(format!("it exports: {list}")),
-                    });
-                }
-                Some(Some(alias)) => {
-                    let alias = alias.clone();
-                    let mut segs = self.segs(s, &alias)?;
-                    if let Some(i) = next.index {
-                        if let Some(last) = segs.last_mut() {
-                            if last.index.is_none() {
-                                last.index = Some(i);
-                            }
-                        }
-                    }
-                    segs.extend_from_slice(&rest[1..]);
-                    return self.resolve(s, &segs, span);
-                }
-                Some(None) => {}
-            }
-        }
-        match self.scopes[s].names.get(&key).cloned() {
-            Some(n) => self.follow(n, next, &rest[1..], span),
-            None => {
-                let comp = self.scopes[s]
-                    .instance
-                    .clone()
-                    .map(|i| i.0)
-                    .unwrap_or_default();
-                let names: Vec<String> = self.scopes[s].names.keys().cloned().collect();
-                let d =
-                    Diagnostic::error(Code::E0201, format!("component `{comp}` has no `{key}`"))
-                        .at(next.name.span, "not declared in the component");
-                Err(match did_you_mean(&key, names.iter().map(|n| n.as_str())) {
-                    Some(m) => d.hint(format!("did you mean `{m}`?")),
-                    None => d.hint(format!("it declares: {}", names.join(", "))),
-                })
-            }
-        }
     }
 
     /// The expression of property `prop` of a declaration, if written.
@@ -919,6 +718,13 @@ impl Names for Cx<'_> {
             v = component(v, seg)?;
         }
         Ok(v)
+    }
+
+    fn angle(&mut self, e: &Expr, value: f64, what: &str) {
+        if let Some(d) = self.env.bare_angle(self.scope, e, Some(value), what) {
+            let d = self.env.trace(self.scope, d);
+            self.env.errors.push(d);
+        }
     }
 
     fn function(&mut self, name: &Ident) -> Result<Option<Value>, Diagnostic> {

@@ -110,6 +110,8 @@ pub trait Names {
     fn path(&mut self, path: &Path) -> Result<Value, Diagnostic>;
     /// A user function called as `name(arg)`, if one is declared.
     fn function(&mut self, name: &Ident) -> Result<Option<Value>, Diagnostic>;
+    /// `e`, of constant value `value`, is the angle of `what`: warn if it has no unit (W0203).
+    fn angle(&mut self, _e: &Expr, _value: f64, _what: &str) {}
 }
 
 pub fn eval(expr: &Expr, names: &mut dyn Names) -> Result<Value, Diagnostic> {
@@ -175,7 +177,7 @@ fn dimensionless_fn(v: &Value, span: Span, what: &str) -> Result<TimeFn, Diagnos
             Code::E0202,
             format!("{what} needs a dimensionless argument"),
         )
-        .at(span, format!("this is a {}", d.describe()))
+        .at(span, format!("this is {}", d.describe()))
         .hint(
             "angles are plain numbers (radians); divide by a reference quantity to make a ratio",
         ));
@@ -200,10 +202,10 @@ fn same_dim(a: Dim, b: Dim, op: &str, lspan: Span, rspan: Span) -> Result<(), Di
     if a != b {
         return Err(Diagnostic::error(
             Code::E0202,
-            format!("cannot {op} a {} and a {}", a.describe(), b.describe()),
+            format!("cannot {op} {} and {}", a.describe(), b.describe()),
         )
-        .at(rspan, format!("this is a {}", b.describe()))
-        .at(lspan, format!("this is a {}", a.describe()))
+        .at(rspan, format!("this is {}", b.describe()))
+        .at(lspan, format!("this is {}", a.describe()))
         .hint(
             "both sides of `+`, `-`, `min` and `max` must have the same dimension; check the units",
         ));
@@ -563,7 +565,7 @@ fn call(
                 Code::E0202,
                 format!("`{name}` is a function of time; its argument must be a time"),
             )
-            .at(args[0].span, format!("this is a {}", d.describe()))
+            .at(args[0].span, format!("this is {}", d.describe()))
             .hint(format!("write `{name}(t - 2 s)` or `{name}(2 * t)`")));
         }
         let (parts, dim) = f.parts().unwrap_or_default();
@@ -630,7 +632,7 @@ fn call(
         if d != Dim::TIME {
             return Err(
                 Diagnostic::error(Code::E0202, format!("`{name}` takes times"))
-                    .at(args[k].span, format!("this is a {}", d.describe()))
+                    .at(args[k].span, format!("this is {}", d.describe()))
                     .hint(format!("write `{}`", usage(name))),
             );
         }
@@ -643,7 +645,7 @@ fn call(
             let Some(dim) = d.sqrt() else {
                 return Err(Diagnostic::error(
                     Code::E0202,
-                    format!("cannot take the square root of a {}", d.describe()),
+                    format!("cannot take the square root of {}", d.describe()),
                 )
                 .at(args[0].span, "odd powers of its units")
                 .hint(
@@ -714,9 +716,10 @@ fn call(
                     Code::E0202,
                     "the angle of `rotate` must be dimensionless",
                 )
-                .at(args[1].span, format!("this is a {}", d.describe()))
+                .at(args[1].span, format!("this is {}", d.describe()))
                 .hint("write an angle such as `30 deg` or `0.5 rad`"));
             }
+            names.angle(&args[1], angle, "the angle of `rotate`");
             Ok(Value::Rotation {
                 matrix: rotation(n.map(|x| x / len), angle),
             })
@@ -753,7 +756,7 @@ fn call(
             let (w, e) = scalar(&vals[1], args[1].span, "the angular frequency of `sine`")?;
             if e != Dim::new(0, 0, -1) {
                 return Err(Diagnostic::error(Code::E0202, "the angular frequency of `sine` must be a frequency")
-                    .at(args[1].span, format!("this is a {}", e.describe()))
+                    .at(args[1].span, format!("this is {}", e.describe()))
                     .hint("write `sine(amplitude, omega)` with omega in rad/s, e.g. `sine(20 N, 9.26 rad/s)`; for a frequency f in Hz write `2 * pi * f`"));
             }
             let phase = match vals.get(2) {
@@ -764,9 +767,10 @@ fn call(
                             Code::E0202,
                             "the phase of `sine` must be an angle",
                         )
-                        .at(args[2].span, format!("this is a {}", d.describe()))
+                        .at(args[2].span, format!("this is {}", d.describe()))
                         .hint("write the phase in rad or deg"));
                     }
+                    names.angle(&args[2], x, "the phase of `sine`");
                     x
                 }
                 None => 0.0,
@@ -855,7 +859,7 @@ fn piecewise(
         let (t, td) = scalar(&eval_inner(te, names)?, te.span, "a knot time")?;
         if td != Dim::TIME {
             return Err(Diagnostic::error(Code::E0202, "a knot time must be a time")
-                .at(te.span, format!("this is a {}", td.describe()))
+                .at(te.span, format!("this is {}", td.describe()))
                 .hint("write knots as `time: value`, e.g. `5 ms: 20 N`"));
         }
         let (v, vd) = scalar(&eval_inner(ve, names)?, ve.span, "a knot value")?;

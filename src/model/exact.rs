@@ -76,15 +76,15 @@ impl Builder<'_> {
                     let d = Diagnostic::error(
                         Code::E0202,
                         format!(
-                            "channel `{}` is a {}, its exact solution a {}",
+                            "channel `{}` is {}, its exact solution {}",
                             column.column,
                             dim.describe(),
                             v.dim().describe()
                         ),
                     )
-                    .at(value.span, format!("this is a {}", v.dim().describe()))
+                    .at(value.span, format!("this is {}", v.dim().describe()))
                     .at(column.span, "the channel is declared here")
-                    .hint(super::build::unit_hint(dim));
+                    .hint(super::build::unit_hint(dim.into(), false));
                     self.error(scope, d);
                     continue;
                 }

@@ -4,6 +4,7 @@
 //! dimensions and topology, and fixes the order of the unknowns (each multiplier after the
 //! unknowns it couples). Reports every error it finds. Must not know integrators or faer.
 
+mod angles;
 mod beams;
 mod bodies;
 mod build;
@@ -17,6 +18,7 @@ mod exact;
 pub use exact::channel_dim;
 mod output_calls;
 mod outputs;
+mod resolve;
 mod settings;
 pub mod topology;
 mod types;

@@ -14,7 +14,17 @@ impl Builder<'_> {
         o: &Overrides,
         top: ScopeId,
         file_span: Span,
+        header: Span,
     ) -> Option<SolveSpec> {
+        if item.is_none() && (o.until.is_none() || (o.dt.is_none() && o.steps.is_none())) {
+            self.error(
+                top,
+                Diagnostic::error(Code::E0229, "the model has no `solve` block")
+                    .at(header, "this model has no `solve` block")
+                    .hint("add one at the top level of the model file, e.g. `solve hht { dt = 1 ms, until = 1 s }`: the method, the time step and the end time"),
+            );
+            return None;
+        }
         let (method, props, span) = match item {
             Some(Item::Solve {
                 method,

@@ -1,15 +1,15 @@
 //! The types of component parameters: `blades: int`, `hinge_offset: length`, `hub: marker`.
 
 use super::eval::Value;
-use super::units::Dim;
+use super::units::{self, Dim, Quantity};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamType {
     Int,
     /// `true` or `false` (1 or 0).
     Bool,
-    /// A scalar of this dimension, constant or varying in time.
-    Scalar(Dim, &'static str),
+    /// A scalar of this dimension (named as the quantity), constant or varying in time.
+    Scalar(Quantity),
     /// A vector of this dimension.
     Vector(Dim, &'static str),
     /// A dimensionless non-zero vector, normalised.
@@ -28,80 +28,80 @@ pub enum ParamType {
 pub const TYPES: &[(&str, ParamType, &str)] = &[
     ("int", ParamType::Int, "4"),
     ("bool", ParamType::Bool, "true"),
-    ("real", ParamType::Scalar(Dim::NONE, "real"), "0.5"),
-    ("angle", ParamType::Scalar(Dim::NONE, "angle"), "30 deg"),
-    ("length", ParamType::Scalar(Dim::LENGTH, "length"), "0.3 m"),
-    ("mass", ParamType::Scalar(Dim::MASS, "mass"), "20 kg"),
-    ("time", ParamType::Scalar(Dim::TIME, "time"), "0.5 s"),
+    (
+        "real",
+        ParamType::Scalar(Quantity::new(Dim::NONE, "a real number", "", "0.5")),
+        "0.5",
+    ),
+    ("angle", ParamType::Scalar(units::ANGLE), "30 deg"),
+    ("length", ParamType::Scalar(Dim::LENGTH.quantity()), "0.3 m"),
+    ("mass", ParamType::Scalar(Dim::MASS.quantity()), "20 kg"),
+    ("time", ParamType::Scalar(Dim::TIME.quantity()), "0.5 s"),
     (
         "velocity",
-        ParamType::Scalar(Dim::VELOCITY, "velocity"),
+        ParamType::Scalar(Dim::VELOCITY.quantity()),
         "1.5 m/s",
     ),
     (
         "acceleration",
-        ParamType::Scalar(Dim::ACCELERATION, "acceleration"),
+        ParamType::Scalar(Dim::ACCELERATION.quantity()),
         "9.81 m/s^2",
     ),
     (
         "angular_velocity",
-        ParamType::Scalar(Dim::new(0, 0, -1), "angular_velocity"),
+        ParamType::Scalar(Dim::new(0, 0, -1).quantity()),
         "98.17 rad/s",
     ),
     (
         "frequency",
-        ParamType::Scalar(Dim::new(0, 0, -1), "frequency"),
+        ParamType::Scalar(units::FREQUENCY),
         "9.26 rad/s",
     ),
-    ("force", ParamType::Scalar(Dim::FORCE, "force"), "20 N"),
-    (
-        "torque",
-        ParamType::Scalar(Dim::new(1, 2, -2), "torque"),
-        "2.5 kN*m",
-    ),
+    ("force", ParamType::Scalar(Dim::FORCE.quantity()), "20 N"),
+    ("torque", ParamType::Scalar(units::TORQUE), "2.5 kN*m"),
     (
         "stiffness",
-        ParamType::Scalar(Dim::new(1, 0, -2), "stiffness"),
+        ParamType::Scalar(Dim::new(1, 0, -2).quantity()),
         "15434 N/m",
     ),
     (
         "torsional_stiffness",
-        ParamType::Scalar(Dim::new(1, 2, -2), "torsional_stiffness"),
+        ParamType::Scalar(units::TORSIONAL_STIFFNESS),
         "14 N*m/rad",
     ),
     (
         "damping",
-        ParamType::Scalar(Dim::new(1, 0, -1), "damping"),
+        ParamType::Scalar(Dim::new(1, 0, -1).quantity()),
         "100 N*s/m",
     ),
     (
         "torsional_damping",
-        ParamType::Scalar(Dim::new(1, 2, -1), "torsional_damping"),
+        ParamType::Scalar(Dim::new(1, 2, -1).quantity()),
         "2 N*m*s/rad",
     ),
     (
         "inertia",
-        ParamType::Scalar(Dim::new(1, 2, 0), "inertia"),
+        ParamType::Scalar(Dim::new(1, 2, 0).quantity()),
         "48.6 kg*m^2",
     ),
     (
         "mass_per_length",
-        ParamType::Scalar(Dim::new(1, -1, 0), "mass_per_length"),
+        ParamType::Scalar(Dim::new(1, -1, 0).quantity()),
         "3.29 kg/m",
     ),
     (
         "bending_stiffness",
-        ParamType::Scalar(Dim::new(1, 3, -2), "bending_stiffness"),
+        ParamType::Scalar(Dim::new(1, 3, -2).quantity()),
         "1.28e4 N*m^2",
     ),
     (
         "axial_stiffness",
-        ParamType::Scalar(Dim::FORCE, "axial_stiffness"),
+        ParamType::Scalar(units::AXIAL_STIFFNESS),
         "8.53e7 N",
     ),
     (
         "pressure",
-        ParamType::Scalar(Dim::new(1, -1, -2), "pressure"),
+        ParamType::Scalar(Dim::new(1, -1, -2).quantity()),
         "70 GPa",
     ),
     (
@@ -150,8 +150,9 @@ impl ParamType {
         match self {
             ParamType::Int => "a whole number".to_string(),
             ParamType::Bool => "`true` or `false`".to_string(),
-            ParamType::Scalar(d, n) => format!("a {n} ({})", d.describe()),
-            ParamType::Vector(d, n) => format!("a {n} vector ({})", d.describe()),
+            ParamType::Scalar(q) => q.describe(),
+            ParamType::Vector(d, _) if d.is_none() => "a dimensionless vector".to_string(),
+            ParamType::Vector(d, n) => format!("a {n} vector [{}]", d.unit()),
             ParamType::Direction => "a direction (a non-zero dimensionless vector)".to_string(),
             ParamType::Function => "a scalar or a function of time".to_string(),
             ParamType::Marker => "a marker".to_string(),
@@ -171,20 +172,25 @@ impl ParamType {
 
     /// Checks a value against the type; `Err` describes what was found.
     pub fn accepts(&self, v: &Value) -> Result<(), String> {
-        let found = || {
-            if v.dim().is_none() {
-                v.kind_name().to_string()
-            } else {
-                format!("{} of {}", v.kind_name(), v.dim().describe())
+        let found = || match v {
+            Value::Scalar { dim, .. } => dim.describe(),
+            Value::Vector { dim, .. } if dim.is_none() => "a dimensionless vector".to_string(),
+            Value::Vector { dim, .. } => format!("a vector in [{}]", dim.unit()),
+            Value::Signal { parts, dim } if parts.len() == 1 => {
+                format!("{}, varying in time", dim.describe())
             }
+            Value::Signal { dim, .. } => format!("a vector in [{}], varying in time", dim.unit()),
+            Value::Rotation { .. } => "a rotation".to_string(),
         };
         let ok = match (self, v) {
             (ParamType::Int, Value::Scalar { value, dim }) => dim.is_none() && value.fract() == 0.0,
             (ParamType::Bool, Value::Scalar { value, dim }) => {
                 dim.is_none() && (*value == 0.0 || *value == 1.0)
             }
-            (ParamType::Scalar(d, _), Value::Scalar { dim, .. }) => d == dim,
-            (ParamType::Scalar(d, _), Value::Signal { parts, dim }) => parts.len() == 1 && d == dim,
+            (ParamType::Scalar(q), Value::Scalar { dim, .. }) => q.dim == *dim,
+            (ParamType::Scalar(q), Value::Signal { parts, dim }) => {
+                parts.len() == 1 && q.dim == *dim
+            }
             (ParamType::Vector(d, _), Value::Vector { dim, .. }) => d == dim,
             (ParamType::Vector(d, _), Value::Signal { parts, dim }) => parts.len() == 3 && d == dim,
             (ParamType::Direction, Value::Vector { value, dim }) => {

@@ -167,7 +167,11 @@ pub struct Component {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Arg {
     pub name: Ident,
+    /// The value; for `base = earth @ (0, 0, 1) m`, the path `earth`.
     pub value: Expr,
+    /// The offset of a marker argument, `@ (0, 0, 1) m`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub offset: Option<Expr>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize)]

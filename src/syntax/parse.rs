@@ -146,7 +146,8 @@ fn syntax_hint(expected: &[&str]) -> String {
     } else if expected.contains(&"an expression") || expected.contains(&"a value") {
         "write a value here: a number with an optional unit (`0.5 m`), a param name, a vector `(x, y, z)` or a call".to_string()
     } else {
-        "check the declaration against the examples in README.md".to_string()
+        "check the declaration against the examples of docs/language.md, the language reference"
+            .to_string()
     }
 }
 
@@ -179,9 +180,12 @@ fn internal(what: &str) -> Diagnostic {
 }
 
 impl Cx {
+    /// The pair's span without the whitespace pest's implicit separators leave at its end, so
+    /// a label under a declaration stays on its lines.
     fn span(&self, p: &Pair<Rule>) -> Span {
         let s = p.as_span();
-        Span::new(self.source, s.start(), s.end())
+        let text = p.as_str();
+        Span::new(self.source, s.start(), s.start() + text.trim_end().len())
     }
 
     fn ident(&self, p: Pair<Rule>) -> Ident {
@@ -362,8 +366,25 @@ impl Cx {
                     .map(|q| {
                         let mut jt = q.into_inner();
                         let name = self.ident(take(&mut jt, "argument name")?);
-                        let value = self.expr(take(&mut jt, "argument value")?)?;
-                        Ok(Arg { name, value })
+                        let v = take(&mut jt, "argument value")?;
+                        if v.as_rule() == Rule::marker {
+                            let m = self.marker(v)?;
+                            let value = Expr {
+                                span: m.path.span,
+                                kind: ExprKind::Path { path: m.path },
+                            };
+                            return Ok(Arg {
+                                name,
+                                value,
+                                offset: m.offset,
+                            });
+                        }
+                        let value = self.expr(v)?;
+                        Ok(Arg {
+                            name,
+                            value,
+                            offset: None,
+                        })
                     })
                     .collect::<Parsed<_>>()?;
                 Item::Instance {
