@@ -404,7 +404,7 @@ pub fn channel_unit(c: &Compiled, column: &str) -> Option<String> {
     if let Some(u) = angular {
         return Some(u.to_string());
     }
-    model::channel_dim(&c.model.joints, &o.probe).map(|d| d.to_string())
+    model::channel_dim(&c.model.joints, &o.probe).map(|d| d.unit())
 }
 
 /// A number with at most six significant digits, no trailing zeros: `31.4`, `0.001`.
