@@ -118,6 +118,9 @@ pub struct Integrator<'s> {
     /// The iterate of the step being solved.
     trial: State,
     rhs: Vec<f64>,
+    /// The right-hand side kept while the constrained mass matrix is solved (FET solves it
+    /// every step), to retry after [`StartMetric::widen`] without allocating.
+    mass_rhs: Vec<f64>,
     /// Scaling used for the current step and for `cur.lambda`.
     aug: Augment,
     stats: RunStats,
@@ -192,6 +195,7 @@ impl<'s> Integrator<'s> {
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
             rhs: vec![0.0; n],
+            mass_rhs: vec![0.0; n],
             aug: Augment {
                 s: 1.0,
                 p: 1.0,
@@ -263,7 +267,7 @@ impl<'s> Integrator<'s> {
     /// Solves `[M, s B^T; s B, 0] x = rhs` at `trial` (the constrained mass matrix, in the
     /// physical layout: virtual rotations).
     fn solve_constrained_mass(&mut self, rhs_and_x: &mut [f64]) -> Result<(), StepFailure> {
-        let rhs = rhs_and_x.to_vec();
+        self.mass_rhs.copy_from_slice(rhs_and_x);
         loop {
             self.start
                 .assemble(&mut self.asm, self.sys, &self.trial, self.aug);
@@ -274,7 +278,7 @@ impl<'s> Integrator<'s> {
             match solved {
                 Ok(()) => return Ok(()),
                 // A rigid body's massless motion held by a spring alone: regularize it too.
-                Err(_) if self.start.widen() => rhs_and_x.copy_from_slice(&rhs),
+                Err(_) if self.start.widen() => rhs_and_x.copy_from_slice(&self.mass_rhs),
                 Err(e) => return Err(self.singular(e)),
             }
         }

@@ -36,6 +36,8 @@ pub(super) struct StartMetric {
     weight: f64,
     /// Scratch: the stiffness values.
     stiff: Vec<f64>,
+    /// Scratch: the columns a node's rows touch.
+    cols: Vec<usize>,
 }
 
 fn coeffs(mass: f64, position: f64) -> TangentCoeffs {
@@ -92,6 +94,7 @@ impl StartMetric {
             frames,
             weight,
             stiff: Vec::new(),
+            cols: Vec::new(),
         }
     }
 
@@ -122,7 +125,7 @@ impl StartMetric {
         }
         asm.tangent(sys, st, aug, coeffs(1.0, 0.0));
         let p = &asm.pattern;
-        let mut cols: Vec<usize> = Vec::new();
+        let cols = &mut self.cols;
         for (idx, proj) in &self.nodes {
             // The pattern is structurally symmetric: the node's rows have entries in the
             // columns that its columns have entries in.
@@ -132,7 +135,7 @@ impl StartMetric {
             }
             cols.sort_unstable();
             cols.dedup();
-            for &col in &cols {
+            for &col in cols.iter() {
                 let slots = idx.map(|i| p.slot(i, col));
                 let k: [f64; 6] = slots.map(|s| s.map_or(0.0, |s| self.stiff[s]));
                 for (i, s) in slots.iter().enumerate() {
