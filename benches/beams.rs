@@ -10,7 +10,7 @@
 //! once before timing, so error and time sit side by side.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
-use mbd::model::{Integrator, Overrides};
+use mbd::settings::{Method, Request};
 use std::time::Duration;
 
 fn source() -> String {
@@ -29,10 +29,10 @@ fn scaling(c: &mut Criterion) {
     for elements in [10usize, 100, 1_000, 10_000] {
         let sets = vec![format!("elements={elements}")];
         let dt = std::f64::consts::PI / 98.17 / 360.0;
-        let o = Overrides {
+        let o = Request {
             dt: Some(dt),
             until: Some(4.0 * dt),
-            ..Overrides::default()
+            ..Request::default()
         };
         let Ok(compiled) = mbd::compile("rotating_beam", &text, &sets, o) else {
             eprintln!("{elements} elements: does not compile");
@@ -62,17 +62,17 @@ fn fig6(c: &mut Criterion) {
     let mut group = c.benchmark_group("rotating_beam: half turn (Fig. 6)");
     group.sample_size(10);
     let runs = [12usize, 18, 36, 180, 360, 720]
-        .map(|n| (n, Integrator::Hht))
+        .map(|n| (n, Method::Hht))
         .into_iter()
-        .chain([36usize, 180, 720].map(|n| (n, Integrator::Fet)));
+        .chain([36usize, 180, 720].map(|n| (n, Method::Fet)));
     for (steps, integrator) in runs {
-        let o = Overrides {
+        let o = Request {
             steps: Some(steps),
-            integrator: Some(integrator),
-            ..Overrides::default()
+            method: Some(integrator),
+            ..Request::default()
         };
         let label = match integrator {
-            Integrator::Fet => format!("fet/{steps}"),
+            Method::Fet => format!("fet/{steps}"),
             _ => steps.to_string(),
         };
         let Ok(compiled) = mbd::compile("rotating_beam", &text, &[], o) else {

@@ -2,7 +2,7 @@
 //! build, topology checks (dense ranks) and unknown numbering.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbd::model::Overrides;
+use mbd::settings::Request;
 
 fn model(name: &str) -> String {
     std::fs::read_to_string(format!("{}/models/{name}.mbd", env!("CARGO_MANIFEST_DIR")))
@@ -20,7 +20,7 @@ fn compile(c: &mut Criterion) {
         let text = model(name);
         let label = format!("check {name} {}", sets.join(" "));
         c.bench_function(label.trim(), |b| {
-            b.iter(|| mbd::compile(name, &text, &sets, Overrides::default()).is_ok())
+            b.iter(|| mbd::compile(name, &text, &sets, Request::default()).is_ok())
         });
     }
 }

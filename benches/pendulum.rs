@@ -1,7 +1,7 @@
 //! Benchmarks: parse + lower, and the 200-step pendulum (P2) run.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbd::model::Overrides;
+use mbd::settings::Request;
 
 fn pendulum_text() -> String {
     std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/models/pendulum.mbd"))
@@ -11,13 +11,13 @@ fn pendulum_text() -> String {
 fn compile(c: &mut Criterion) {
     let text = pendulum_text();
     c.bench_function("pendulum: parse + check + lower", |b| {
-        b.iter(|| mbd::compile("pendulum.mbd", &text, &[], Overrides::default()).is_ok())
+        b.iter(|| mbd::compile("pendulum.mbd", &text, &[], Request::default()).is_ok())
     });
 }
 
 fn run(c: &mut Criterion) {
     let text = pendulum_text();
-    let Ok(compiled) = mbd::compile("pendulum.mbd", &text, &[], Overrides::default()) else {
+    let Ok(compiled) = mbd::compile("pendulum.mbd", &text, &[], Request::default()) else {
         return;
     };
     let mut out = Vec::with_capacity(1 << 16);

@@ -3,7 +3,7 @@
 //! are printed once before timing.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbd::model::{Integrator, Overrides, Rotations};
+use mbd::settings::{Method, Request, Rotations};
 
 fn text(model: &str) -> String {
     std::fs::read_to_string(format!("{}/models/{model}", env!("CARGO_MANIFEST_DIR")))
@@ -14,14 +14,14 @@ fn runs(c: &mut Criterion) {
     for model in ["two_bar.mbd", "two_bar_spin.mbd", "pendulum.mbd"] {
         let source = text(model);
         for (name, rotations, integrator) in [
-            ("incremental", Rotations::Incremental, Integrator::Hht),
-            ("conformal", Rotations::Conformal, Integrator::Hht),
-            ("fet", Rotations::Incremental, Integrator::Fet),
+            ("incremental", Rotations::Incremental, Method::Hht),
+            ("conformal", Rotations::Conformal, Method::Hht),
+            ("fet", Rotations::Incremental, Method::Fet),
         ] {
-            let o = Overrides {
+            let o = Request {
                 rotations: Some(rotations),
-                integrator: Some(integrator),
-                ..Overrides::default()
+                method: Some(integrator),
+                ..Request::default()
             };
             let Ok(compiled) = mbd::compile(model, &source, &[], o) else {
                 continue;

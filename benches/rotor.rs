@@ -5,7 +5,7 @@
 //! `mbd stability` itself (see the closing note of issue 7).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use mbd::study::sweep::{self, Method, SweepSpec};
 
 fn text() -> String {
@@ -18,7 +18,7 @@ fn text() -> String {
 
 fn runs(c: &mut Criterion) {
     let source = text();
-    if let Ok(compiled) = mbd::compile("windmill.mbd", &source, &[], Overrides::default()) {
+    if let Ok(compiled) = mbd::compile("windmill.mbd", &source, &[], Request::default()) {
         let mut out = Vec::with_capacity(1 << 22);
         c.bench_function("windmill: 3 s run, 6000 steps", |b| {
             b.iter(|| {
@@ -40,7 +40,7 @@ fn runs(c: &mut Criterion) {
             refine: 0,
         };
         let compile = |extra: &[String]| {
-            mbd::compile("windmill.mbd", &source, extra, Overrides::default())
+            mbd::compile("windmill.mbd", &source, extra, Request::default())
                 .map_err(|f| format!("{:?}", f.diagnostics))
         };
         c.bench_function(&format!("windmill: one {} point", method.name()), |b| {

@@ -16,6 +16,7 @@ pub mod lower;
 pub mod model;
 pub mod output;
 pub mod runtime;
+pub mod settings;
 pub mod solve;
 pub mod source;
 pub mod stdlib;
@@ -26,10 +27,8 @@ use diagnostics::{Code, Diagnostic, Sink};
 use lower::Provenance;
 use model::{Loader, Model, NoFiles, Overrides};
 use runtime::System;
-use solve::{
-    FailureKind, Method, NoticeKind, RotationTreatment, RunStats, RuntimeFailure, Settings,
-    StartMode,
-};
+use settings::{Method, Request, Rotations, Settings};
+use solve::{FailureKind, NoticeKind, RunStats, RuntimeFailure};
 use source::SourceMap;
 use std::io::Write;
 
@@ -38,6 +37,8 @@ pub struct Compiled {
     pub sources: SourceMap,
     pub ast: syntax::ast::File,
     pub model: Model,
+    /// The solver settings: the `solve` block with the command line's request laid over it.
+    pub settings: Settings,
     /// The runtime system, or why this version cannot simulate the model (E0501).
     pub lowered: Result<Lowered, Diagnostic>,
     /// Warnings found while compiling.
@@ -57,14 +58,15 @@ pub struct CompileFailure {
 }
 
 /// Compiles model text with the built-in standard library only.
-/// `sets` are the raw `NAME=VALUE` texts of `--set` flags.
+/// `sets` are the raw `NAME=VALUE` texts of `--set` flags; `solve` the command line's solver
+/// settings, laid over the model's `solve` block.
 pub fn compile(
     name: &str,
     text: &str,
     sets: &[String],
-    overrides: Overrides,
+    solve: Request,
 ) -> Result<Compiled, CompileFailure> {
-    compile_with(name, text, sets, overrides, &NoFiles)
+    compile_with(name, text, sets, solve, &NoFiles)
 }
 
 /// Compiles model text; `loader` finds the modules it `use`s outside the standard library.
@@ -72,9 +74,13 @@ pub fn compile_with(
     name: &str,
     text: &str,
     sets: &[String],
-    mut overrides: Overrides,
+    solve: Request,
     loader: &dyn Loader,
 ) -> Result<Compiled, CompileFailure> {
+    let mut overrides = Overrides {
+        sets: Vec::new(),
+        solve,
+    };
     let mut sources = SourceMap::new();
     let id = sources.add(name, text);
     let mut sink = Sink::default();
@@ -106,11 +112,22 @@ pub fn compile_with(
             })
         }
     };
+    // The model stage has reported the settings' mistakes already.
+    let settings = match Settings::resolve(&model.solve, &overrides.solve) {
+        Ok(s) => s,
+        Err(diagnostics) => {
+            return Err(CompileFailure {
+                sources,
+                diagnostics,
+            })
+        }
+    };
     let lowered = lower::lower(&model).map(|(system, provenance)| Lowered { system, provenance });
     Ok(Compiled {
         sources,
         ast,
         model,
+        settings,
         lowered,
         warnings: sink.diagnostics,
     })
@@ -162,45 +179,10 @@ pub fn check_library(
 }
 
 impl Compiled {
-    /// Solver settings from the model's `solve` block (with command-line overrides applied).
-    pub fn settings(&self) -> Settings {
-        let s = &self.model.solve;
-        Settings {
-            method: match s.integrator {
-                model::Integrator::Hht => Method::Hht,
-                model::Integrator::GeneralizedAlpha => Method::GeneralizedAlpha,
-                model::Integrator::Fet => Method::Fet,
-                model::Integrator::Static => Method::Static,
-            },
-            alpha: s.alpha,
-            rho_inf: s.rho_inf,
-            rotation: match s.rotations {
-                model::Rotations::Incremental => RotationTreatment::Incremental,
-                model::Rotations::Conformal => RotationTreatment::Conformal,
-            },
-            dt: s.dt,
-            steps: s.steps,
-            every: s.every,
-            start: match s.start {
-                model::Start::Consistent => StartMode::Consistent,
-                model::Start::ZeroAcceleration => StartMode::ZeroAcceleration,
-            },
-            increment_tolerance: s.tolerance,
-            residual_tolerance: 1e-8,
-            max_iterations: s.max_iterations,
-            // Statics: a load step that fails is split, up to 1/16 of its size.
-            max_halvings: if s.integrator == model::Integrator::Static {
-                4
-            } else {
-                3
-            },
-        }
-    }
-
     /// A runtime failure as a diagnostic pointing at the entity's declaration.
     pub fn failure_diagnostic(&self, f: &RuntimeFailure) -> Diagnostic {
         let (code, what, hint) = match f.kind {
-            FailureKind::NewtonDiverged if self.settings().method == Method::Fet => (Code::E0601, "Newton iteration failed", "time finite elements have no numerical dissipation, and the midpoint rule is not stable for stiff beams in large motion (THEORY §8.2): use `--integrator hht` (alpha -0.1), or try a smaller time step (--dt)"),
+            FailureKind::NewtonDiverged if self.settings.method == Method::Fet => (Code::E0601, "Newton iteration failed", "time finite elements have no numerical dissipation, and the midpoint rule is not stable for stiff beams in large motion (THEORY §8.2): use `--integrator hht` (alpha -0.1), or try a smaller time step (--dt)"),
             FailureKind::NewtonDiverged => (Code::E0601, "Newton iteration failed", "try a smaller time step (--dt), more numerical dissipation (--alpha -0.3), or check for a load or motion that is discontinuous or too large"),
             FailureKind::Singular => (Code::E0602, "singular iteration matrix", "check that every body has a positive mass and that no two joints constrain the same motion"),
             FailureKind::NonFinite => (Code::E0603, "non-finite values", "try a smaller time step (--dt); check params for extreme values"),
@@ -265,7 +247,7 @@ pub fn run_with_progress(
     out: &mut dyn Write,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport, RunFailure> {
-    let set = c.settings();
+    let set = &c.settings;
     let l = match &c.lowered {
         Ok(l) => l,
         Err(d) => {
@@ -285,7 +267,7 @@ pub fn run_with_progress(
         warnings: Vec::new(),
         rows,
     };
-    if set.method == Method::Fet && set.rotation == RotationTreatment::Conformal {
+    if set.method == Method::Fet && set.rotations == Rotations::Conformal {
         let f = RuntimeFailure {
             kind: FailureKind::Unsupported,
             t: 0.0,
@@ -314,7 +296,7 @@ pub fn run_with_progress(
             rows,
         }
     };
-    let mut hht = match solve::Integrator::new(sys, &set) {
+    let mut hht = match solve::Integrator::new(sys, set) {
         Ok(h) => h,
         Err(f) => return Err(fail(f, &mut csv, warnings, 0)),
     };
@@ -337,18 +319,18 @@ pub fn run_with_progress(
     csv.row(sys, hht.state(), hht.augment())
         .map_err(|e| io_fail(e, 0))?;
     let mut rows = 1;
-    for k in 1..=set.steps {
-        if let Err(f) = hht.step(k, set.dt) {
-            return Err(fail(f, &mut csv, warnings, rows));
-        }
+    let ran = hht.run(|k, it| {
         progress(k, set.steps);
-        // Exact step times, free of accumulated round-off.
-        hht.set_time(k as f64 * set.dt);
         if k % set.every == 0 || k == set.steps {
-            csv.row(sys, hht.state(), hht.augment())
-                .map_err(|e| io_fail(e, rows))?;
+            csv.row(sys, it.state(), it.augment())?;
             rows += 1;
         }
+        Ok(())
+    });
+    match ran {
+        Ok(()) => {}
+        Err(solve::Stop::Failed(f)) => return Err(fail(f, &mut csv, warnings, rows)),
+        Err(solve::Stop::Stopped(e)) => return Err(io_fail(e, rows)),
     }
     csv.flush().map_err(|e| io_fail(e, rows))?;
     Ok(RunReport {
@@ -363,7 +345,7 @@ pub fn run_with_progress(
 /// with `frozen` gives the frozen-time eigenvalues, marked as such in [`solve::modes::Frame`].
 pub fn modes(c: &Compiled, frozen: bool) -> Result<solve::modes::Modes, Diagnostic> {
     let l = c.lowered.as_ref().map_err(Clone::clone)?;
-    solve::modes::modes(&l.system, &c.settings(), frozen).map_err(|f| match f {
+    solve::modes::modes(&l.system, &c.settings, frozen).map_err(|f| match f {
         solve::modes::ModesFailure::Runtime(f) => c.failure_diagnostic(&f),
         solve::modes::ModesFailure::Unsteady(why) => c.unsteady_diagnostic(&why),
     })

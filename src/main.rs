@@ -4,7 +4,7 @@
 
 use clap::{Parser, Subcommand, ValueEnum};
 use mbd::diagnostics::{explain, render_human, render_json, Diagnostic};
-use mbd::model::{Integrator, Overrides, Rotations, Start};
+use mbd::settings::{Method, Request, Rotations, Start};
 use mbd::source::SourceMap;
 use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
@@ -217,35 +217,12 @@ fn main() -> ExitCode {
             start,
             format,
         } => {
-            if let Some(r) = rho_inf {
-                if !(0.0..=1.0).contains(&r) {
-                    return usage(&format!("--rho-inf {r} is outside [0, 1]"));
-                }
-            }
-            if let Some(a) = alpha {
-                if !(-1.0 / 3.0 - 1e-12..=0.0).contains(&a) {
-                    return usage(&format!("--alpha {a} is outside [-1/3, 0]"));
-                }
-            }
-            for (flag, v) in [("--dt", dt), ("--until", until)] {
-                if let Some(v) = v {
-                    if !(v > 0.0 && v.is_finite()) {
-                        return usage(&format!(
-                            "{flag} must be a positive number of seconds, got {v}"
-                        ));
-                    }
-                }
-            }
-            if steps == Some(0) || every == Some(0) {
-                return usage("--steps and --every must be at least 1");
-            }
-            let overrides = Overrides {
-                sets: Vec::new(),
-                integrator: integrator.map(|i| match i {
-                    IntegratorArg::Hht => Integrator::Hht,
-                    IntegratorArg::GeneralizedAlpha => Integrator::GeneralizedAlpha,
-                    IntegratorArg::Fet => Integrator::Fet,
-                    IntegratorArg::Static => Integrator::Static,
+            let request = Request {
+                method: integrator.map(|i| match i {
+                    IntegratorArg::Hht => Method::Hht,
+                    IntegratorArg::GeneralizedAlpha => Method::GeneralizedAlpha,
+                    IntegratorArg::Fet => Method::Fet,
+                    IntegratorArg::Static => Method::Static,
                 }),
                 alpha,
                 rho_inf,
@@ -261,8 +238,12 @@ fn main() -> ExitCode {
                     StartArg::Consistent => Start::Consistent,
                     StartArg::Zero => Start::ZeroAcceleration,
                 }),
+                ..Request::default()
             };
-            run(&model, output.as_deref(), &set, overrides, format)
+            if let Some(bad) = request.check().first() {
+                return usage(&bad.flag_message());
+            }
+            run(&model, output.as_deref(), &set, request, format)
         }
     }
 }
@@ -292,7 +273,7 @@ fn plot(
                 Ok(t) => t,
                 Err(code) => return code,
             };
-            match compile(m, &source, sets, Overrides::default(), Format::Human) {
+            match compile(m, &source, sets, Request::default(), Format::Human) {
                 Ok(c) => Some(c),
                 Err(code) => return code,
             }
@@ -328,10 +309,10 @@ fn compile(
     path: &str,
     text: &str,
     sets: &[String],
-    overrides: Overrides,
+    solve: Request,
     format: Format,
 ) -> Result<mbd::Compiled, ExitCode> {
-    match mbd::compile_with(path, text, sets, overrides, &FsLoader::new()) {
+    match mbd::compile_with(path, text, sets, solve, &FsLoader::new()) {
         Ok(c) => {
             report(&c.warnings, &c.sources, format);
             Ok(c)
@@ -381,7 +362,7 @@ pub(crate) fn sweep_values(
         let mut all = sets.to_vec();
         all.push(format!("{param}={part}"));
         let fail = |why: String| usage(&format!("--sweep: the range's {what} `{part}`: {why}"));
-        match mbd::compile_with(path, text, &all, Overrides::default(), &FsLoader::new()) {
+        match mbd::compile_with(path, text, &all, Request::default(), &FsLoader::new()) {
             Ok(c) => c
                 .model
                 .params
@@ -509,7 +490,7 @@ fn check(path: &str, format: Format, emit: Option<Emit>, sets: &[String]) -> Exi
             }
         };
     }
-    let c = match compile(path, &text, sets, Overrides::default(), format) {
+    let c = match compile(path, &text, sets, Request::default(), format) {
         Ok(c) => c,
         Err(code) => return code,
     };
@@ -549,7 +530,7 @@ fn summary(c: &mbd::Compiled, format: Format) -> String {
             "model": m.name, "bodies": m.bodies.len(), "beams": m.beams.len(), "nodes": nodes,
             "joints": m.joints.len(), "dofs": n - mult - m.dofs.extras(), "extra_unknowns": m.dofs.extras(),
             "multipliers": mult, "unknowns": n, "bandwidth": m.dofs.bandwidth, "nonzeros": nonzeros,
-            "channels": columns, "steps": m.solve.steps, "dt": m.solve.dt, "until": m.solve.until,
+            "channels": columns, "steps": c.settings.steps, "dt": c.settings.dt, "until": c.settings.until,
             "runnable": c.lowered.is_ok(),
         })
         .to_string();
@@ -564,9 +545,9 @@ fn summary(c: &mbd::Compiled, format: Format) -> String {
         mbd::model::topology::report(m),
         nonzeros.map(|x| x.to_string()).unwrap_or_else(|| "-".to_string()),
         std::iter::once("t").chain(columns.iter().copied()).collect::<Vec<_>>().join(", "),
-        m.solve.steps,
-        m.solve.dt,
-        m.solve.until
+        c.settings.steps,
+        c.settings.dt,
+        c.settings.until
     )
 }
 
@@ -621,14 +602,14 @@ fn run(
     path: &str,
     output: Option<&str>,
     sets: &[String],
-    overrides: Overrides,
+    solve: Request,
     format: Format,
 ) -> ExitCode {
     let text = match read(path) {
         Ok(t) => t,
         Err(code) => return code,
     };
-    let c = match compile(path, &text, sets, overrides, format) {
+    let c = match compile(path, &text, sets, solve, format) {
         Ok(c) => c,
         Err(code) => return code,
     };

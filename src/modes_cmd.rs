@@ -5,7 +5,7 @@ use crate::{
     compile, create_outputs, draw, read, report, sweep_values, usage, Format, FsLoader, EXIT_MODEL,
     EXIT_RUNTIME,
 };
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use mbd::solve::modes::{Frame, Modes};
 use mbd::study::fan::{self, FanSpec};
 use mbd::study::sweep::Tick;
@@ -85,7 +85,7 @@ pub fn modes(a: ModesArgs) -> ExitCode {
     if a.sweep.is_some() {
         return sweep(&a, &text);
     }
-    let c = match compile(&a.model, &text, &a.set, Overrides::default(), a.format) {
+    let c = match compile(&a.model, &text, &a.set, Request::default(), a.format) {
         Ok(c) => c,
         Err(code) => return code,
     };
@@ -182,7 +182,7 @@ fn sweep(a: &ModesArgs, text: &str) -> ExitCode {
     // The model compiles at the first value (its errors and warnings, once).
     let mut first = a.set.clone();
     first.push(format!("{param}={}", values[0]));
-    let c = match compile(&a.model, text, &first, Overrides::default(), a.format) {
+    let c = match compile(&a.model, text, &first, Request::default(), a.format) {
         Ok(c) => c,
         Err(code) => return code,
     };
@@ -206,7 +206,7 @@ fn sweep(a: &ModesArgs, text: &str) -> ExitCode {
     let compile_job = |extra: &[String]| {
         let mut all = sets.to_vec();
         all.extend_from_slice(extra);
-        mbd::compile_with(path, text, &all, Overrides::default(), &FsLoader::new()).map_err(|f| {
+        mbd::compile_with(path, text, &all, Request::default(), &FsLoader::new()).map_err(|f| {
             f.diagnostics
                 .iter()
                 .find(|d| d.is_error())

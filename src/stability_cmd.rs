@@ -6,8 +6,8 @@ use super::{
     compile, create_outputs, draw, read, report, say, short, sweep_values, usage, Format, FsLoader,
     EXIT_MODEL, EXIT_RUNTIME,
 };
-use mbd::model::Overrides;
 use mbd::output::charts::Series;
+use mbd::settings::Request;
 use mbd::study::sweep::{self, Method, SweepSpec, Tick};
 use std::io::IsTerminal;
 use std::process::ExitCode;
@@ -152,7 +152,7 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         &a.model,
         &text,
         &first_sets,
-        Overrides::default(),
+        Request::default(),
         Format::Human,
     ) {
         Ok(c) => c,
@@ -217,7 +217,7 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
     let compile_job = |extra: &[String]| {
         let mut all = sets.to_vec();
         all.extend_from_slice(extra);
-        mbd::compile_with(path, &text, &all, Overrides::default(), &FsLoader::new()).map_err(|f| {
+        mbd::compile_with(path, &text, &all, Request::default(), &FsLoader::new()).map_err(|f| {
             f.diagnostics
                 .iter()
                 .find(|d| d.is_error())

@@ -6,7 +6,7 @@ use super::{
     compile, create_outputs, draw, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL,
     EXIT_RUNTIME,
 };
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use mbd::study::compare::Samples;
 use mbd::study::convergence::{self, ConvergenceSpec, ReferenceSpec};
 use mbd::study::stability::{self, Detector, StabilitySpec};
@@ -125,10 +125,10 @@ pub fn study(a: StudyArgs) -> ExitCode {
             ));
         }
     }
-    let base = Overrides {
+    let base = Request {
         every: Some(1),
         until: a.until,
-        ..Overrides::default()
+        ..Request::default()
     };
     let c = match compile(&a.model, &text, &a.set, base.clone(), Format::Human) {
         Ok(c) => c,
@@ -150,13 +150,13 @@ pub fn study(a: StudyArgs) -> ExitCode {
             a.model, a.channel
         ));
     }
-    let until = c.model.solve.until;
+    let until = c.settings.until;
     let counts = match &steps {
         Some(s) => match s.counts(until) {
             Ok(n) => n,
             Err(e) => return usage(&e),
         },
-        None => vec![c.model.solve.steps],
+        None => vec![c.settings.steps],
     };
     // Fail on unwritable outputs now, not after the runs.
     let (mut csv_file, mut chart_file) = match create_outputs(&a.output, a.chart.as_deref()) {
@@ -164,7 +164,7 @@ pub fn study(a: StudyArgs) -> ExitCode {
         Err(code) => return code,
     };
     let (path, sets) = (a.model.as_str(), a.set.as_slice());
-    let compile_job = |o: &Overrides| {
+    let compile_job = |o: &Request| {
         mbd::compile_with(path, &text, sets, o.clone(), &FsLoader::new()).map_err(|f| {
             f.diagnostics
                 .iter()

@@ -84,6 +84,10 @@ fn runtime_and_solve_know_nothing_of_spans() {
                 !text.contains("crate::model") && !text.contains("crate::syntax"),
                 "{path} reaches back up the pipeline"
             );
+            assert!(
+                !path.starts_with("src/solve/") || !text.contains("Element::"),
+                "{path} matches concrete elements: the solve stage drives the runtime through its generic interface"
+            );
         }
     }
 }

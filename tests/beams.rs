@@ -4,7 +4,7 @@
 
 use crate::common::{read, simulate, Trace};
 use crate::reference::dopri;
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use std::f64::consts::PI;
 
 fn last(t: &Trace, c: &str) -> f64 {
@@ -24,7 +24,7 @@ fn cantilever_rolls_into_the_exact_arcs_and_a_full_circle() {
     let t = simulate(
         "models/cantilever.mbd",
         &[&format!("M={m}")],
-        Overrides::default(),
+        Request::default(),
     );
     let (ts, xs, ys, zs) = (t.col("t"), t.col("x"), t.col("y"), t.col("z"));
     let mut worst = 0.0f64;
@@ -48,7 +48,7 @@ fn small_tip_force_gives_the_linear_deflection() {
     let t = simulate(
         "models/cantilever.mbd",
         &[&format!("P={p}")],
-        Overrides::default(),
+        Request::default(),
     );
     // Timoshenko: bending P L^3 / (3 EI) plus shear P L / GA (GA = 1e7 N, 3e-5 of the total).
     let exact = -p * l.powi(3) / (3.0 * ei) - p * l / 1e7;
@@ -98,7 +98,7 @@ fn large_tip_force_matches_the_elastica() {
         let t = simulate(
             "models/cantilever.mbd",
             &[&format!("P={p}")],
-            Overrides::default(),
+            Request::default(),
         );
         let (x, d) = (last(&t, "x"), -last(&t, "z"));
         let err = ((x - xe).powi(2) + (d - de).powi(2)).sqrt();
@@ -115,7 +115,7 @@ fn large_tip_force_matches_the_elastica() {
 }
 
 fn modes_of(name: &str, text: &str, sets: &[String]) -> Vec<f64> {
-    let c = match mbd::compile(name, text, sets, Overrides::default()) {
+    let c = match mbd::compile(name, text, sets, Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{name}: {:?}", f.diagnostics),
     };
@@ -183,9 +183,9 @@ fn rotating_beam_phase_error_falls_at_second_order() {
         let t = simulate(
             "models/rotating_beam.mbd",
             &[],
-            Overrides {
+            Request {
                 steps: Some(n),
-                ..Overrides::default()
+                ..Request::default()
             },
         );
         errors.push((n, (last(&t, "phi") - PI) / PI));
@@ -213,10 +213,10 @@ fn two_bar_beams_agree_with_the_rigid_two_bar() {
     // Near-rigid bars (EI 1.28e7 N*m^2 under loads of 0.1 N: deflections ~1e-10 m); the same
     // step (10 ms): the difference is the integration of two discretizations of the same
     // inertia. Measured over 10 s: theta2 6.3e-3 rad, centre of mass 1.3e-3 m.
-    let o = || Overrides {
+    let o = || Request {
         dt: Some(0.01),
         until: Some(10.0),
-        ..Overrides::default()
+        ..Request::default()
     };
     let beams = simulate("models/two_bar_beams.mbd", &[], o());
     let rigid = simulate("models/two_bar.mbd", &[], o());
@@ -243,14 +243,14 @@ fn two_bar_beams_runs_the_papers_case_at_its_step() {
     // each is about 0.1 rad from the exact solution at this step, rigid: 0.093 rad in
     // tests/rigid.rs); after the load reversal the two discrete solutions separate, as any two
     // discretizations of this motion do at this step.
-    let beams = simulate("models/two_bar_beams.mbd", &[], Overrides::default());
+    let beams = simulate("models/two_bar_beams.mbd", &[], Request::default());
     let t = beams.col("t");
     assert!(
         (t[t.len() - 1] - 50.0).abs() < 1e-9,
         "ended at {}",
         t[t.len() - 1]
     );
-    let rigid = simulate("models/two_bar.mbd", &[], Overrides::default());
+    let rigid = simulate("models/two_bar.mbd", &[], Request::default());
     let (a, b) = (beams.col("theta2"), rigid.col("theta2"));
     let worst = (0..=200).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max);
     eprintln!("two_bar_beams dt 0.05: theta2 within {worst:.3e} rad of the rigid model to 10 s");
@@ -266,10 +266,10 @@ fn elastic_two_bar_root_torque_exceeds_the_rigid_one_and_converges() {
         simulate(
             model,
             sets,
-            Overrides {
+            Request {
                 dt: Some(dt),
                 until: Some(5.0),
-                ..Overrides::default()
+                ..Request::default()
             },
         )
     };

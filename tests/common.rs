@@ -1,6 +1,6 @@
 //! Helpers shared by the integration tests.
 
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use std::path::PathBuf;
 
 pub fn repo(path: &str) -> PathBuf {
@@ -29,7 +29,7 @@ impl Trace {
 }
 
 /// Compiles and runs a shipped model through the library API, as `mbd run` does.
-pub fn simulate(model: &str, sets: &[&str], overrides: Overrides) -> Trace {
+pub fn simulate(model: &str, sets: &[&str], overrides: Request) -> Trace {
     let text = read(model);
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let compiled = match mbd::compile(model, &text, &sets, overrides) {
@@ -47,11 +47,7 @@ pub fn simulate(model: &str, sets: &[&str], overrides: Overrides) -> Trace {
 
 /// Compiles and runs model text; on a run-time failure returns the rows written before it and
 /// the failure message.
-pub fn simulate_text(
-    name: &str,
-    text: &str,
-    overrides: Overrides,
-) -> Result<Trace, (Trace, String)> {
+pub fn simulate_text(name: &str, text: &str, overrides: Request) -> Result<Trace, (Trace, String)> {
     simulate_text_with(name, text, &[], overrides)
 }
 
@@ -60,7 +56,7 @@ pub fn simulate_text_with(
     name: &str,
     text: &str,
     sets: &[&str],
-    overrides: Overrides,
+    overrides: Request,
 ) -> Result<Trace, (Trace, String)> {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
     let compiled = match mbd::compile(name, text, &sets, overrides) {

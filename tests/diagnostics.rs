@@ -3,7 +3,7 @@
 
 use crate::common::{read, repo};
 use mbd::diagnostics::{render_human, Code, Diagnostic, ALL_CODES};
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use mbd::source::SourceMap;
 
 /// (case under tests/ui, the code it must produce)
@@ -115,7 +115,7 @@ fn import_cycles_are_reported_and_user_modules_load() {
     const A: &str = "use \"parts/b.mbd\"\ncomponent pend(base: marker) {\n    point_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n    joint link = distance(base, bob)\n}\n";
     const FILES: &[(&str, &str)] = &[("parts/a.mbd", A), ("parts/b.mbd", "use parts::a\n")];
     let cyclic = Modules(FILES);
-    let f = match mbd::compile_with("m.mbd", model, &[], Overrides::default(), &cyclic) {
+    let f = match mbd::compile_with("m.mbd", model, &[], Request::default(), &cyclic) {
         Ok(_) => panic!("an import cycle must be an error"),
         Err(f) => f,
     };
@@ -125,7 +125,7 @@ fn import_cycles_are_reported_and_user_modules_load() {
     // Without the cycle the same component loads from the user's module.
     const FINE: &[(&str, &str)] = &[("parts/a.mbd", "component pend(base: marker) {\n    point_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n    joint link = distance(base, bob)\n}\n")];
     let fine = Modules(FINE);
-    let c = mbd::compile_with("m.mbd", model, &[], Overrides::default(), &fine);
+    let c = mbd::compile_with("m.mbd", model, &[], Request::default(), &fine);
     match c {
         Ok(c) => assert_eq!(c.model.bodies[0].name, "p.bob"),
         Err(f) => panic!("{}", render_all(&f.diagnostics, &f.sources)),
@@ -142,7 +142,7 @@ ground earth\n\
 beam blade { from = (0, 0, 0) m, to = (2, 0, 0) m, section = s, elements = 2 }\n\
 joint pin = revolute(earth @ (0.3, 0, 0) m, blade.at(0.3 m)) { axis = z }\n\
 solve hht { dt = 1 ms, until = 1 s }\n";
-    let c = match mbd::compile("between.mbd", source, &[], Overrides::default()) {
+    let c = match mbd::compile("between.mbd", source, &[], Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{}", render_all(&f.diagnostics, &f.sources)),
     };
@@ -170,7 +170,7 @@ fn compile_case(name: &str, source: &str, sets: &[String]) -> (Vec<Code>, String
         &format!("tests/ui/{name}.mbd"),
         source,
         sets,
-        Overrides::default(),
+        Request::default(),
     ) {
         Ok(c) => (c.warnings, c.sources),
         Err(f) => (f.diagnostics, f.sources),
@@ -276,7 +276,7 @@ fn every_code_has_an_explanation_and_a_distinct_spelling() {
 }
 
 /// Runs a model and renders what the run reports: warnings, then the failure if any.
-fn run_case(name: &str, text: &str, overrides: Overrides) -> (Vec<Code>, String) {
+fn run_case(name: &str, text: &str, overrides: Request) -> (Vec<Code>, String) {
     let c = match mbd::compile(name, text, &[], overrides) {
         Ok(c) => c,
         Err(f) => panic!("{name} does not compile: {:?}", f.diagnostics),
@@ -299,13 +299,13 @@ fn run_case(name: &str, text: &str, overrides: Overrides) -> (Vec<Code>, String)
 #[test]
 fn runtime_diagnostics_name_when_and_where() {
     let pendulum = read("models/pendulum.mbd");
-    let two_steps = || Overrides {
+    let two_steps = || Request {
         steps: Some(2),
         ..Default::default()
     };
-    let fet = Overrides {
-        integrator: Some(mbd::model::Integrator::Fet),
-        rotations: Some(mbd::model::Rotations::Conformal),
+    let fet = Request {
+        method: Some(mbd::settings::Method::Fet),
+        rotations: Some(mbd::settings::Rotations::Conformal),
         ..Default::default()
     };
     let cases = [
@@ -315,7 +315,7 @@ fn runtime_diagnostics_name_when_and_where() {
                 "solve hht(alpha = -0.1) {",
                 "solve hht(alpha = -0.1, max_iterations = 1) {",
             ),
-            Overrides::default(),
+            Request::default(),
             Code::E0601,
         ),
         (
@@ -327,13 +327,13 @@ fn runtime_diagnostics_name_when_and_where() {
         (
             "run_non_finite",
             pendulum.replacen("param V0 = 1.5 m/s", "param V0 = 1e150 m/s", 1),
-            Overrides::default(),
+            Request::default(),
             Code::E0603,
         ),
         (
             "run_singular",
             pendulum.replacen("param V0 = 1.5 m/s", "param V0 = 1e160 m/s", 1),
-            Overrides::default(),
+            Request::default(),
             Code::E0602,
         ),
         (
@@ -359,7 +359,7 @@ fn runtime_diagnostics_name_when_and_where() {
 #[test]
 fn modes_refuses_a_rotor_on_a_still_mast_and_names_both() {
     let text = crate::modes::teetering(true);
-    let c = match mbd::compile("teeter.mbd", &text, &[], Overrides::default()) {
+    let c = match mbd::compile("teeter.mbd", &text, &[], Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("teeter does not compile: {:?}", f.diagnostics),
     };

@@ -3,7 +3,7 @@
 //! code its `# error EXXXX` comment names. Blocks with any other tag (```text, ```sh) are prose.
 
 use mbd::diagnostics::render_human;
-use mbd::model::Overrides;
+use mbd::settings::Request;
 
 const DOC: &str = "docs/language.md";
 
@@ -30,7 +30,7 @@ impl Example {
     }
 
     fn compile(&self) -> Result<mbd::Compiled, mbd::CompileFailure> {
-        mbd::compile(&self.name(), &self.text, &[], Overrides::default())
+        mbd::compile(&self.name(), &self.text, &[], Request::default())
     }
 
     fn describe(&self) -> String {

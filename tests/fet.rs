@@ -7,13 +7,13 @@ use crate::common::{read, simulate, simulate_text};
 use crate::pendulum::{final_error, sawtooth, Reference};
 use crate::reference::{free_body, TwoBar};
 use crate::rigid::{angle_between, com_error, order, overrides, two_bar, FREE_BODY, M};
-use mbd::model::{Integrator, Overrides};
+use mbd::settings::{Method, Request};
 use std::f64::consts::PI;
 
-fn fet() -> Overrides {
-    Overrides {
-        integrator: Some(Integrator::Fet),
-        ..Overrides::default()
+fn fet() -> Request {
+    Request {
+        method: Some(Method::Fet),
+        ..Request::default()
     }
 }
 
@@ -66,7 +66,7 @@ fn fet_is_the_trapezoidal_rule_on_a_linear_oscillator_and_keeps_its_amplitude() 
         .iter()
         .map(|ek| (ek - 0.5).abs() / 0.5)
         .fold(0.0, f64::max);
-    let hht = simulate_text("oscillator.mbd", OSCILLATOR, Overrides::default())
+    let hht = simulate_text("oscillator.mbd", OSCILLATOR, Request::default())
         .unwrap_or_else(|(_, m)| panic!("{m}"));
     let hht_loss = 1.0 - hht.col("e").last().copied().unwrap_or(0.0) / 0.5;
     eprintln!("oscillator, 10,000 steps at omega h = 0.2: FET from the trapezoidal rule {worst:.3e} (of the amplitude), energy drift {drift:.3e}; HHT -0.1 energy loss {hht_loss:.3}");
@@ -90,7 +90,7 @@ fn fet_is_second_order_on_the_pendulum() {
             let tr = simulate(
                 "models/pendulum.mbd",
                 &[],
-                Overrides {
+                Request {
                     dt: Some(dt),
                     ..fet()
                 },
@@ -119,8 +119,8 @@ fn fet_is_second_order_on_a_free_body_and_keeps_its_angular_momentum() {
         let tr = simulate_text(
             "free_body.mbd",
             FREE_BODY,
-            Overrides {
-                integrator: Some(Integrator::Fet),
+            Request {
+                method: Some(Method::Fet),
                 ..overrides(dt, t_end)
             },
         )
@@ -175,7 +175,7 @@ fn fet_is_second_order_on_the_rotating_beam() {
             let tr = simulate(
                 "models/rotating_beam.mbd",
                 &[],
-                Overrides {
+                Request {
                     steps: Some(n),
                     ..fet()
                 },
@@ -229,12 +229,12 @@ fn fet_keeps_the_oscillation_a_kinked_drive_excites_and_hht_damps_it() {
         )
         .replace("until = 50 s", "until = 20 s");
     assert!(text.contains("10.05 s"), "the drive was not replaced");
-    let torque = |o: Overrides| -> Vec<f64> {
+    let torque = |o: Request| -> Vec<f64> {
         simulate_text("kink.mbd", &text, o)
             .unwrap_or_else(|(_, m)| panic!("{m}"))
             .col("torque")
     };
-    let (f, h) = (torque(fet()), torque(Overrides::default()));
+    let (f, h) = (torque(fet()), torque(Request::default()));
     let (f_kink, f_late) = (sawtooth(&f, 206..240), sawtooth(&f, 360..398));
     let (h_kink, h_late) = (sawtooth(&h, 206..240), sawtooth(&h, 360..398));
     eprintln!("drive-torque sawtooth after the kink / at the end: FET {f_kink:.3e} / {f_late:.3e} N m, HHT -0.1 {h_kink:.3e} / {h_late:.3e} N m");

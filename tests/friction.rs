@@ -2,12 +2,12 @@
 
 use crate::common::{simulate_text, Trace};
 use mbd::diagnostics::{Code, Diagnostic};
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use mbd::source::SourceMap;
 
 /// Compiles model text; `Ok` with the warnings, `Err` with every diagnostic.
 fn check(text: &str) -> Result<Vec<Diagnostic>, (Vec<Diagnostic>, SourceMap)> {
-    match mbd::compile("friction.mbd", text, &[], Overrides::default()) {
+    match mbd::compile("friction.mbd", text, &[], Request::default()) {
         Ok(c) => Ok(c.warnings),
         Err(f) => Err((f.diagnostics, f.sources)),
     }
@@ -26,7 +26,7 @@ fn errors(text: &str) -> Vec<Diagnostic> {
 }
 
 fn run(text: &str) -> Trace {
-    match simulate_text("friction.mbd", text, Overrides::default()) {
+    match simulate_text("friction.mbd", text, Request::default()) {
         Ok(t) => t,
         Err((_, msg)) => panic!("run failed: {msg}"),
     }
@@ -139,7 +139,7 @@ joint link = distance(earth, bob)
     assert_eq!(codes(&d), vec![Code::E0103, Code::E0229]);
     assert_eq!(d[1].labels[0].span.start, 0);
     // The command line may stand in for the block.
-    let o = Overrides {
+    let o = Request {
         until: Some(0.1),
         dt: Some(0.01),
         ..Default::default()
@@ -461,12 +461,7 @@ rigid_rod bar { from = (0, 0, 0) m, to = (1, 0, 0) m, mass = 1 kg }
 joint pin = revolute(earth, bar.start) { axis = z, spring = 1 N*m/rad, rest_angle = tilt }
 solve hht { dt = 0.01 s, until = 0.1 s }
 ";
-    match mbd::compile(
-        "m.mbd",
-        text,
-        &["tilt=0.1".to_string()],
-        Overrides::default(),
-    ) {
+    match mbd::compile("m.mbd", text, &["tilt=0.1".to_string()], Request::default()) {
         Ok(c) => assert!(c.warnings.is_empty(), "{:?}", codes(&c.warnings)),
         Err(f) => panic!("{:?}", codes(&f.diagnostics)),
     }

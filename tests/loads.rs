@@ -7,10 +7,10 @@
 
 use crate::common::{simulate_text, Trace};
 use crate::modes::teetering;
-use mbd::model::Overrides;
+use mbd::settings::Request;
 
 fn run(name: &str, text: &str) -> Trace {
-    simulate_text(name, text, Overrides::default()).unwrap_or_else(|(_, e)| panic!("{name}: {e}"))
+    simulate_text(name, text, Request::default()).unwrap_or_else(|(_, e)| panic!("{name}: {e}"))
 }
 
 /// A rod (8 kg, 2 m) welded at its root to a massless hub driven at 10 rad/s about z, with

@@ -3,12 +3,13 @@
 
 use crate::common::{read, repo};
 use mbd::diagnostics::render_human;
-use mbd::model::{Drive, JointKind, Model, Overrides};
+use mbd::model::{Drive, JointKind, Model};
+use mbd::settings::Request;
 
 fn compile(path: &str, sets: &[&str]) -> mbd::Compiled {
     let text = read(path);
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    match mbd::compile(path, &text, &sets, Overrides::default()) {
+    match mbd::compile(path, &text, &sets, Request::default()) {
         Ok(c) => {
             let w: Vec<String> = c
                 .warnings
@@ -369,7 +370,7 @@ fn rotating_beam_starts_in_the_stretched_state() {
             );
             assert!(close(beam.velocities[k], [0.0, omega * x[0], 0.0], 1e-9));
         }
-        assert!((c.model.solve.until - std::f64::consts::PI / omega).abs() < 1e-16);
+        assert!((c.settings.until - std::f64::consts::PI / omega).abs() < 1e-16);
     }
 }
 
@@ -384,7 +385,7 @@ fn stdlib_rods_instantiate() {
         "(0, 1, 0) m, to = (1, 1, 0) m",
         "(0.5, 0, 0) m, to = (1.5, 0, 0) m",
     );
-    let c = match mbd::compile("rods.mbd", &text, &[], Overrides::default()) {
+    let c = match mbd::compile("rods.mbd", &text, &[], Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{}", rendered(&f)),
     };

@@ -7,11 +7,11 @@
 
 use crate::cli::{code, mbd, stderr, temp};
 use mbd::diagnostics::Code;
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use mbd::solve::modes::{Frame, Modes};
 
 fn modes_of(name: &str, text: &str, frozen: bool) -> Result<Modes, mbd::diagnostics::Diagnostic> {
-    let c = match mbd::compile(name, text, &[], Overrides::default()) {
+    let c = match mbd::compile(name, text, &[], Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{name}: {:?}", f.diagnostics),
     };

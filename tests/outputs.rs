@@ -5,7 +5,7 @@
 
 use crate::common::{read, simulate, simulate_text, Trace};
 use mbd::diagnostics::Code;
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use std::f64::consts::TAU;
 
 /// The windmill's data (models/windmill.mbd): rotor speed Omega = Omega_bar omega_T with
@@ -14,8 +14,8 @@ const OMEGA: f64 = 9.26;
 const E: f64 = 0.3;
 const L: f64 = 2.7;
 
-fn half_second() -> Overrides {
-    Overrides {
+fn half_second() -> Request {
+    Request {
         until: Some(0.5),
         ..Default::default()
     }
@@ -194,13 +194,13 @@ output cm = center_of_mass(a), v = center_of_mass(a).velocity\n\
 output acc = center_of_mass(a).acceleration, plate_x = center_of_mass(a.plate).x\n\
 output center_of_mass(a.tail).position.y\n\
 solve hht { dt = 1 ms, until = 0.05 s }\n";
-    let compiled = match mbd::compile("cm.mbd", text, &[], Overrides::default()) {
+    let compiled = match mbd::compile("cm.mbd", text, &[], Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{:?}", f.diagnostics),
     };
     let frame = compiled.model.beams[0].frame;
     let axis2 = [frame[0][1], frame[1][1], frame[2][1]];
-    let trace = match simulate_text("cm.mbd", text, Overrides::default()) {
+    let trace = match simulate_text("cm.mbd", text, Request::default()) {
         Ok(t) => t,
         Err((_, m)) => panic!("{m}"),
     };
@@ -363,7 +363,7 @@ fn bad_output_function_calls_are_rejected_with_their_codes() {
     ];
     for (line, code) in cases {
         let text = windmill_with(line);
-        match mbd::compile("windmill.mbd", &text, &[], Overrides::default()) {
+        match mbd::compile("windmill.mbd", &text, &[], Request::default()) {
             Ok(_) => panic!("`{line}` compiles"),
             Err(f) => {
                 let codes: Vec<Code> = f.diagnostics.iter().map(|d| d.code).collect();
@@ -383,7 +383,7 @@ fn bad_output_function_calls_are_rejected_with_their_codes() {
         "windmill.mbd",
         &text,
         &["blades=1".to_string()],
-        Overrides::default(),
+        Request::default(),
     ) {
         Ok(_) => panic!("one blade compiles"),
         Err(f) => {
@@ -406,7 +406,7 @@ fn unnamed_output_functions_are_named_after_what_they_measure() {
     let text = windmill_with(
         "output multiblade(rotor.lag.angle, rotor.drive), center_of_mass(rotor.blade[1]).velocity",
     );
-    let c = match mbd::compile("windmill.mbd", &text, &[], Overrides::default()) {
+    let c = match mbd::compile("windmill.mbd", &text, &[], Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{:?}", f.diagnostics),
     };

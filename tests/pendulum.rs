@@ -4,7 +4,7 @@
 //! elliptic-function solution.
 
 use crate::common::{simulate, Trace};
-use mbd::model::{Overrides, Start};
+use mbd::settings::{Request, Start};
 
 const G: f64 = 9.81;
 const L: f64 = 0.5;
@@ -89,7 +89,7 @@ fn run(dt: f64, alpha: f64, start: Start, sets: &[&str]) -> Trace {
     simulate(
         "models/pendulum.mbd",
         sets,
-        Overrides {
+        Request {
             dt: Some(dt),
             alpha: Some(alpha),
             start: Some(start),
@@ -294,7 +294,7 @@ fn set_accepts_si_numbers_and_values_with_units() {
 /// Runs through the library and returns the run statistics with the trace.
 fn run_with_stats(text: &str, sets: &[&str]) -> (Trace, mbd::solve::RunStats) {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let Ok(c) = mbd::compile("pendulum.mbd", text, &sets, Overrides::default()) else {
+    let Ok(c) = mbd::compile("pendulum.mbd", text, &sets, Request::default()) else {
         panic!("compiles")
     };
     let mut out = Vec::new();

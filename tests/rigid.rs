@@ -6,7 +6,7 @@
 
 use crate::common::{read, simulate_text, Trace};
 use crate::reference::{free_body, TwoBar, TwoBarState};
-use mbd::model::{Overrides, Rotations};
+use mbd::settings::{Request, Rotations};
 use mbd::solve::RunStats;
 use std::f64::consts::PI;
 
@@ -30,11 +30,11 @@ pub(crate) fn angle_between(a: &M, b: &M) -> f64 {
         .acos()
 }
 
-pub(crate) fn overrides(dt: f64, until: f64) -> Overrides {
-    Overrides {
+pub(crate) fn overrides(dt: f64, until: f64) -> Request {
+    Request {
         dt: Some(dt),
         until: Some(until),
-        ..Overrides::default()
+        ..Request::default()
     }
 }
 
@@ -119,12 +119,12 @@ fn times(tr: &Trace) -> Vec<f64> {
     tr.col("t")
 }
 
-pub(crate) fn two_bar(dt: f64, until: f64, extra: Overrides) -> Result<Trace, (Trace, String)> {
+pub(crate) fn two_bar(dt: f64, until: f64, extra: Request) -> Result<Trace, (Trace, String)> {
     let text = read("models/two_bar.mbd");
     simulate_text(
         "models/two_bar.mbd",
         &text,
-        Overrides {
+        Request {
             dt: Some(dt),
             until: Some(until),
             ..extra
@@ -137,7 +137,7 @@ pub(crate) fn two_bar(dt: f64, until: f64, extra: Overrides) -> Result<Trace, (T
 #[test]
 fn two_bar_case_one_matches_the_reduced_equations() {
     let reference = TwoBar::paper_case1();
-    let tr = two_bar(0.05, 10.0, Overrides::default()).unwrap_or_else(|(_, m)| panic!("{m}"));
+    let tr = two_bar(0.05, 10.0, Request::default()).unwrap_or_else(|(_, m)| panic!("{m}"));
     let t = times(&tr);
     let refs = reference.case1(PI / 2.0, &t);
     let worst = (0..t.len())
@@ -158,7 +158,7 @@ fn two_bar_case_one_matches_the_reduced_equations() {
     // dt = 2.5 ms (measured 0.50 m at 10 ms and 0.24 m at 5 ms, not yet asymptotic).
     let mut errs = Vec::new();
     for dt in [0.0025, 0.00125, 0.000625] {
-        let tr = two_bar(dt, 50.0, Overrides::default()).unwrap_or_else(|(_, m)| panic!("{m}"));
+        let tr = two_bar(dt, 50.0, Request::default()).unwrap_or_else(|(_, m)| panic!("{m}"));
         let t = times(&tr);
         let refs = reference.case1(PI / 2.0, &t);
         let e = (0..t.len())
@@ -182,9 +182,9 @@ fn changes_of_state_leave_the_motion_smooth() {
         let tr = two_bar(
             0.01,
             50.0,
-            Overrides {
+            Request {
                 rotations: Some(rotations),
-                ..Overrides::default()
+                ..Request::default()
             },
         )
         .unwrap_or_else(|(_, m)| panic!("{m}"));
@@ -240,9 +240,9 @@ fn numerical_dissipation_delays_and_removes_the_instability() {
         let (tr, failed) = match two_bar(
             0.05,
             50.0,
-            Overrides {
+            Request {
                 alpha: Some(alpha),
-                ..Overrides::default()
+                ..Request::default()
             },
         ) {
             Ok(tr) => (tr, None),
@@ -318,9 +318,9 @@ fn rotation_treatments_compared_on_the_two_bar() {
             let tr = two_bar(
                 dt,
                 10.0,
-                Overrides {
+                Request {
                     rotations: Some(rotations),
-                    ..Overrides::default()
+                    ..Request::default()
                 },
             )
             .unwrap_or_else(|(_, m)| panic!("{m}"));

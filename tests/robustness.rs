@@ -4,7 +4,7 @@
 //! diagnostic, and `mbd check` exits 0 or 1.
 
 use crate::common::{read, repo};
-use mbd::model::Overrides;
+use mbd::settings::Request;
 
 /// A small deterministic generator (no dependency, reproducible failures).
 struct Lcg(u64);
@@ -156,7 +156,7 @@ fn mutated_models_never_panic() {
                 if mbd::is_library(&input) {
                     mbd::check_library(name, &input, &mbd::model::NoFiles).is_ok()
                 } else {
-                    let ok = mbd::compile(name, &input, &[], Overrides::default());
+                    let ok = mbd::compile(name, &input, &[], Request::default());
                     match ok {
                         // Every rejection carries at least one error diagnostic.
                         Err(f) => {

@@ -5,7 +5,7 @@
 
 use crate::common::{read, simulate, simulate_text_with, Trace};
 use crate::reference::dopri_breaks;
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use std::f64::consts::PI;
 
 // ---------------------------------------------------------------------------------------------
@@ -161,9 +161,9 @@ fn windmill_errors(blades: usize, omega_bar: f64, dt: Option<f64>) -> Vec<(Strin
     let tr = simulate(
         "models/windmill.mbd",
         &sets,
-        Overrides {
+        Request {
             dt,
-            ..Overrides::default()
+            ..Request::default()
         },
     );
     let t = tr.col("t");
@@ -280,9 +280,9 @@ fn spinup(t0: f64, dt: Option<f64>) -> Result<Trace, (Trace, String)> {
         "models/windmill_spinup.mbd",
         &text,
         &[&set],
-        Overrides {
+        Request {
             dt,
-            ..Overrides::default()
+            ..Request::default()
         },
     )
 }
@@ -532,10 +532,10 @@ fn elastic(elements: usize, dt: f64) -> Trace {
     simulate(
         "models/windmill_elastic.mbd",
         &[&set],
-        Overrides {
+        Request {
             dt: Some(dt),
             until: Some(1.0),
-            ..Overrides::default()
+            ..Request::default()
         },
     )
 }

@@ -4,7 +4,7 @@
 use crate::cli::{code, mbd, stderr, temp};
 use crate::common::read;
 use crate::mbc::{mbc_edge, mbc_growth, mbc_roots};
-use mbd::model::Overrides;
+use mbd::settings::Request;
 use mbd::study::sweep::{self, Method, Point, Sweep, SweepSpec};
 
 const OMEGA_T: f64 = 9.26;
@@ -29,7 +29,7 @@ fn run(spec: &SweepSpec, blades: usize) -> Sweep {
     let compile = |extra: &[String]| {
         let mut sets = vec![format!("blades={blades}")];
         sets.extend_from_slice(extra);
-        mbd::compile("models/windmill.mbd", &text, &sets, Overrides::default())
+        mbd::compile("models/windmill.mbd", &text, &sets, Request::default())
             .map_err(|f| format!("{:?}", f.diagnostics))
     };
     sweep::sweep(spec, &compile, &|_| {})

@@ -528,7 +528,7 @@ output rope[2].force\n\
 exact y[1] = -1 m\n\
 exact rope[2].force = 9.81 N * cos(w * t)\n\
 solve hht { dt = 0.01 s, until = 1 s }\n";
-    let c = match mbd::compile("chain.mbd", text, &[], mbd::model::Overrides::default()) {
+    let c = match mbd::compile("chain.mbd", text, &[], mbd::settings::Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{:?}", f.diagnostics),
     };

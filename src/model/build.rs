@@ -194,7 +194,7 @@ fn build_model(
             ..file.span
         },
     };
-    let solve = b.solve(out.solve.as_ref(), overrides, top, file.span, header);
+    let solve = b.solve(out.solve.as_ref(), &overrides.solve, top, header);
 
     for e in std::mem::take(&mut b.env.errors) {
         b.sink.push(e);

@@ -62,15 +62,8 @@ impl Loader for NoFiles {
 pub struct Overrides {
     /// `--set NAME=VALUE`, parsed from their own source texts.
     pub sets: Vec<(crate::syntax::ast::Ident, crate::syntax::ast::Expr)>,
-    pub integrator: Option<Integrator>,
-    pub alpha: Option<f64>,
-    pub rho_inf: Option<f64>,
-    pub rotations: Option<Rotations>,
-    pub dt: Option<f64>,
-    pub steps: Option<usize>,
-    pub until: Option<f64>,
-    pub every: Option<usize>,
-    pub start: Option<Start>,
+    /// The command line's solver settings, laid over the `solve` block's.
+    pub solve: crate::settings::Request,
 }
 
 pub type Mat3 = [[f64; 3]; 3];
@@ -92,7 +85,8 @@ pub struct Model {
     pub outputs: Vec<OutputChannel>,
     /// Closed-form solutions of output channels (`exact phi = Omega * t`).
     pub exact: Vec<ExactReference>,
-    pub solve: SolveSpec,
+    /// What the `solve` block wrote (resolved with the command line by `Settings::resolve`).
+    pub solve: crate::settings::Written,
     pub dofs: DofMap,
 }
 
@@ -435,55 +429,5 @@ pub struct ExactReference {
     pub column: String,
     /// The solution in SI units, a function of time.
     pub f: TimeFn,
-    pub span: Span,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Integrator {
-    Hht,
-    /// Generalized-alpha (Arnold-Bruls form).
-    GeneralizedAlpha,
-    Fet,
-    /// Static equilibrium at each step's time (load steps).
-    Static,
-}
-
-/// How rotations are integrated.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Rotations {
-    /// Stored rotation matrices updated by incremental rotations (default).
-    Incremental,
-    /// The paper's total conformal rotation vector, rescaled past pi.
-    Conformal,
-}
-
-/// How the first step starts.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Start {
-    /// Accelerations and multipliers solved from the equations at t = 0 (THEORY §7.3).
-    Consistent,
-    /// Zero accelerations and multipliers, as the paper did (its Fig. 8).
-    ZeroAcceleration,
-}
-
-#[derive(Clone, Debug, Serialize)]
-pub struct SolveSpec {
-    pub integrator: Integrator,
-    /// HHT alpha in [-1/3, 0].
-    pub alpha: f64,
-    /// Generalized-alpha spectral radius at infinity, in [0, 1].
-    pub rho_inf: f64,
-    pub rotations: Rotations,
-    pub dt: f64,
-    pub steps: usize,
-    pub until: f64,
-    pub every: usize,
-    pub start: Start,
-    /// Newton increment tolerance (relative to the model's length scale).
-    pub tolerance: f64,
-    pub max_iterations: usize,
     pub span: Span,
 }

@@ -108,6 +108,27 @@ impl System {
             .collect()
     }
 
+    /// The first unknown of each translation triplet: the rotating nodes' positions, then
+    /// the point masses'.
+    pub fn translation_triplets(&self) -> Vec<usize> {
+        let points = self.elements.iter().filter_map(|e| match e {
+            Element::PointMass(p) => Some(p.dofs[0]),
+            _ => None,
+        });
+        self.translations.iter().copied().chain(points).collect()
+    }
+
+    /// The revolute joints' angle unknowns.
+    pub fn angle_unknowns(&self) -> Vec<usize> {
+        self.elements
+            .iter()
+            .filter_map(|e| match e {
+                Element::Joint(j) => j.angle,
+                _ => None,
+            })
+            .collect()
+    }
+
     /// Whether rotating node `k` is an SE(3) frame (see `coupled`).
     #[inline]
     pub fn is_frame(&self, k: usize) -> bool {

@@ -26,13 +26,14 @@
 //! in its size). The monodromy matrix is that of the discrete map, so its damping carries the
 //! integrator's numerical damping (§7.4).
 
-use super::integrator::Integrator;
+use super::integrator::{Integrator, Linearization};
 use super::linear::{generalized_eigen, null_space};
 use super::modes::c64;
-use super::{RuntimeFailure, Settings, StartMode};
+use super::{RuntimeFailure, Settings, Stop};
 use crate::runtime::rotation::{exp, log, V3};
 use crate::runtime::{State, System, UnknownKind};
 use nalgebra::DMatrix;
+use std::convert::Infallible;
 
 /// Relative size of the perturbations (of the length scale, of a radian).
 pub const EPSILON: f64 = 1e-5;
@@ -168,13 +169,13 @@ fn perturbed(
     st
 }
 
-/// Integrates from the integrator's current (initialized) state over `steps` steps of `h`.
-fn integrate(it: &mut Integrator, steps: usize, h: f64) -> Result<State, RuntimeFailure> {
-    let t0 = it.state().t;
-    for k in 1..=steps {
-        it.step(k, h)?;
-        it.set_time(t0 + k as f64 * h);
-    }
+/// Integrates from the integrator's current (initialized) state over its settings' steps.
+fn integrate(it: &mut Integrator) -> Result<State, RuntimeFailure> {
+    it.run(|_, _| Ok::<(), Infallible>(()))
+        .map_err(|s| match s {
+            Stop::Failed(f) => f,
+            Stop::Stopped(never) => match never {},
+        })?;
     Ok(it.state().clone())
 }
 
@@ -187,44 +188,16 @@ pub fn floquet(
     progress: &dyn Fn(),
 ) -> Result<Floquet, FloquetFailure> {
     let reference_failure = |failure| FloquetFailure { run: None, failure };
-    let steps = ((period / set.dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-    let h = period / steps as f64;
-    let mut set = set.clone();
-    set.dt = h;
-    set.steps = steps;
-    set.start = StartMode::Consistent;
+    let set = set.over(period);
+    let (steps, h) = (set.steps, set.dt);
     let mut it = Integrator::new(sys, &set).map_err(reference_failure)?;
     it.initialize().map_err(reference_failure)?;
     let lin = it.linearize();
     let free = lin.unknowns.clone();
-    let nfree = free.len();
-    // Translations count in units of the length scale, rotations and angles in radians.
-    let angles: Vec<usize> = sys.angle_rows().iter().map(|&(_, a)| a).collect();
-    let weights: Vec<f64> = free
-        .iter()
-        .map(|&i| match sys.unknowns[i] {
-            UnknownKind::Coordinate if !angles.contains(&i) => sys.length_scale,
-            _ => 1.0,
-        })
-        .collect();
-    let mut bw = lin.b.clone();
-    for row in 0..lin.rows {
-        for (j, w) in weights.iter().enumerate() {
-            bw[row * nfree + j] *= w;
-        }
-    }
-    let (basis, r) = null_space(&bw, lin.rows, nfree).ok_or_else(|| {
-        reference_failure(RuntimeFailure {
-            kind: super::FailureKind::Singular,
-            t: 0.0,
-            step: 0,
-            entity: None,
-            detail: "the singular value decomposition of the constraint gradient failed".into(),
-        })
-    })?;
+    let (weights, basis, r) = perturbation_space(sys, &lin).map_err(reference_failure)?;
     let omega = 2.0 * std::f64::consts::PI / period;
     let start_reference = it.state().clone();
-    let reference = integrate(&mut it, steps, h).map_err(reference_failure)?;
+    let reference = integrate(&mut it).map_err(reference_failure)?;
     progress();
     let mut newton_iterations = it.stats().newton_iterations;
     let n = 2 * r;
@@ -250,7 +223,7 @@ pub fn floquet(
                 &weights,
                 omega,
             );
-            let end = integrate(&mut it, steps, h).map_err(fail)?;
+            let end = integrate(&mut it).map_err(fail)?;
             newton_iterations += it.stats().newton_iterations;
             let b = measure(sys, &end, &reference, &free, &basis, &weights, omega);
             for i in 0..n {
@@ -274,32 +247,15 @@ pub fn floquet(
         }
     };
     let phi: Vec<f64> = (0..n * n).map(|k| phi_m[(k % n, k / n)]).collect();
-    let identity: Vec<f64> = (0..n * n)
-        .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
-        .collect();
-    let eig = if n == 0 {
-        Vec::new()
-    } else {
-        generalized_eigen(&phi, &identity, n).ok_or_else(|| {
-            reference_failure(RuntimeFailure {
-                kind: super::FailureKind::Singular,
-                t: period,
-                step: steps,
-                entity: None,
-                detail: "the eigenvalues of the monodromy matrix could not be computed".into(),
-            })
-        })?
-    };
-    let mut multipliers: Vec<c64> = eig
-        .iter()
-        .map(|((ar, ai), (br, bi), _)| {
-            // alpha / beta
-            let d = br * br + bi * bi;
-            c64::new((ar * br + ai * bi) / d, (ai * br - ar * bi) / d)
+    let multipliers = eigenvalues(&phi, n).ok_or_else(|| {
+        reference_failure(RuntimeFailure {
+            kind: super::FailureKind::Singular,
+            t: period,
+            step: steps,
+            entity: None,
+            detail: "the eigenvalues of the monodromy matrix could not be computed".into(),
         })
-        .collect();
-    let modulus = |m: &c64| (m.re * m.re + m.im * m.im).sqrt();
-    multipliers.sort_by(|a, b| modulus(b).total_cmp(&modulus(a)));
+    })?;
     let exponents = multipliers.iter().map(|&m| exponent(m, period)).collect();
     Ok(Floquet {
         period,
@@ -311,4 +267,60 @@ pub fn floquet(
         exponents,
         newton_iterations,
     })
+}
+
+/// The weighted perturbation space: the weights of the free coordinates (translations in
+/// units of the length scale, rotations and angles in radians), the orthonormal basis of the
+/// null space of the weighted constraint gradient, and its dimension.
+fn perturbation_space(
+    sys: &System,
+    lin: &Linearization,
+) -> Result<(Vec<f64>, Vec<f64>, usize), RuntimeFailure> {
+    let nfree = lin.unknowns.len();
+    let angles = sys.angle_unknowns();
+    let weights: Vec<f64> = lin
+        .unknowns
+        .iter()
+        .map(|&i| match sys.unknowns[i] {
+            UnknownKind::Coordinate if !angles.contains(&i) => sys.length_scale,
+            _ => 1.0,
+        })
+        .collect();
+    let mut bw = lin.b.clone();
+    for row in 0..lin.rows {
+        for (j, w) in weights.iter().enumerate() {
+            bw[row * nfree + j] *= w;
+        }
+    }
+    let (basis, r) = null_space(&bw, lin.rows, nfree).ok_or_else(|| RuntimeFailure {
+        kind: super::FailureKind::Singular,
+        t: 0.0,
+        step: 0,
+        entity: None,
+        detail: "the singular value decomposition of the constraint gradient failed".into(),
+    })?;
+    Ok((weights, basis, r))
+}
+
+/// The eigenvalues of the `n x n` column-major matrix `phi`, by decreasing modulus.
+fn eigenvalues(phi: &[f64], n: usize) -> Option<Vec<c64>> {
+    let identity: Vec<f64> = (0..n * n)
+        .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
+        .collect();
+    let eig = if n == 0 {
+        Vec::new()
+    } else {
+        generalized_eigen(phi, &identity, n)?
+    };
+    let mut multipliers: Vec<c64> = eig
+        .iter()
+        .map(|((ar, ai), (br, bi), _)| {
+            // alpha / beta
+            let d = br * br + bi * bi;
+            c64::new((ar * br + ai * bi) / d, (ai * br - ar * bi) / d)
+        })
+        .collect();
+    let modulus = |m: &c64| (m.re * m.re + m.im * m.im).sqrt();
+    multipliers.sort_by(|a, b| modulus(b).total_cmp(&modulus(a)));
+    Some(multipliers)
 }

@@ -13,7 +13,7 @@ use super::linear::{least_squares, null_space};
 use super::modes::{rotating_frame, Unsteady};
 use super::RuntimeFailure;
 use crate::runtime::rotation::{exp, orthonormalize, V3};
-use crate::runtime::{Element, State, System};
+use crate::runtime::{State, System};
 use nalgebra::DMatrix;
 
 /// Relative tolerances of the steadiness tests (the consistent start is exact to about
@@ -38,16 +38,7 @@ pub(super) struct Motion {
 /// Where each translation triplet (node or point mass) and each revolute angle is among the
 /// unknowns: `(translations, angles)`, as first unknowns.
 pub(super) fn coordinates(sys: &System) -> (Vec<usize>, Vec<usize>) {
-    let mut tr = sys.translations.clone();
-    let mut angles = Vec::new();
-    for e in &sys.elements {
-        match e {
-            Element::PointMass(p) => tr.push(p.dofs[0]),
-            Element::Joint(j) => angles.extend(j.angle),
-            _ => {}
-        }
-    }
-    (tr, angles)
+    (sys.translation_triplets(), sys.angle_unknowns())
 }
 
 fn triplet(v: &[f64], i: usize) -> V3 {
@@ -169,7 +160,7 @@ pub(super) fn relax(
     motion: &Motion,
     tolerance: f64,
 ) -> Result<Result<f64, Unsteady>, RuntimeFailure> {
-    let (tr, angles) = coordinates(sys);
+    let tr = sys.translation_triplets();
     let w = motion.spin;
     let ell = sys.length_scale.max(f64::MIN_POSITIVE);
     let first = deviation(sys, st, w);
@@ -196,28 +187,7 @@ pub(super) fn relax(
         for (j, &i) in lin.unknowns.iter().enumerate() {
             pos[i] = j;
         }
-        // d = a_steady - a over the free unknowns.
-        let mut d = vec![0.0; nf];
-        for &i in &tr {
-            let dv = w.cross(&triplet(&now.v, i)) - triplet(&now.a, i);
-            for c in 0..3 {
-                if pos[i + c] != usize::MAX {
-                    d[pos[i + c]] = dv[c];
-                }
-            }
-        }
-        for (k, &r) in sys.rotations.iter().enumerate() {
-            for c in 0..3 {
-                if pos[r + c] != usize::MAX {
-                    d[pos[r + c]] = -now.rot[k].dw[c];
-                }
-            }
-        }
-        for &a in &angles {
-            if pos[a] != usize::MAX {
-                d[pos[a]] = -now.a[a];
-            }
-        }
+        let d = imbalance(sys, &now, w, &pos, nf);
         let (m, _, k) = rotating_frame(sys, &lin, (w.norm() > 0.0).then_some(w));
         let Some((basis, r)) = null_space(&lin.b, lin.rows, nf) else {
             break;
@@ -255,30 +225,8 @@ pub(super) fn relax(
         } else {
             1.0
         };
-        let at = |i: usize| {
-            if pos[i] == usize::MAX {
-                0.0
-            } else {
-                dq[pos[i]] * cut
-            }
-        };
-        let mut next = now.clone();
-        for &i in &tr {
-            let x = triplet(&now.q, i) + V3::new(at(i), at(i + 1), at(i + 2));
-            let v = w.cross(&(x - motion.center)) + motion.v0;
-            for c in 0..3 {
-                next.q[i + c] = x[c];
-                next.v[i + c] = v[c];
-            }
-        }
-        for (k, &r) in sys.rotations.iter().enumerate() {
-            let turn = exp(&V3::new(at(r), at(r + 1), at(r + 2)));
-            let m = orthonormalize(&(turn * now.rot[k].matrix()));
-            next.rot[k].set_matrix(&m);
-        }
-        for &a in &angles {
-            next.q[a] += at(a);
-        }
+        let dq: Vec<f64> = dq.iter().map(|x| x * cut).collect();
+        let next = moved_by(sys, &now, motion, &pos, &dq);
         it.restart(&next)?;
     }
     it.restart(st)?;
@@ -385,4 +333,63 @@ pub(super) fn periodic_change(
         }
     }
     Ok(change)
+}
+
+/// `a_steady - a` over the free unknowns (`pos`: each unknown's place among them, or
+/// `usize::MAX`): what the steady motion's accelerations lack.
+fn imbalance(sys: &System, now: &State, w: V3, pos: &[usize], nf: usize) -> Vec<f64> {
+    let (tr, angles) = coordinates(sys);
+    let mut d = vec![0.0; nf];
+    for &i in &tr {
+        let dv = w.cross(&triplet(&now.v, i)) - triplet(&now.a, i);
+        for c in 0..3 {
+            if pos[i + c] != usize::MAX {
+                d[pos[i + c]] = dv[c];
+            }
+        }
+    }
+    for (k, &r) in sys.rotations.iter().enumerate() {
+        for c in 0..3 {
+            if pos[r + c] != usize::MAX {
+                d[pos[r + c]] = -now.rot[k].dw[c];
+            }
+        }
+    }
+    for &a in &angles {
+        if pos[a] != usize::MAX {
+            d[pos[a]] = -now.a[a];
+        }
+    }
+    d
+}
+
+/// `now` moved by `dq` over the free unknowns (rotations turned by their entries), with the
+/// velocities of the rigid motion at the new positions.
+fn moved_by(sys: &System, now: &State, motion: &Motion, pos: &[usize], dq: &[f64]) -> State {
+    let (tr, angles) = coordinates(sys);
+    let at = |i: usize| {
+        if pos[i] == usize::MAX {
+            0.0
+        } else {
+            dq[pos[i]]
+        }
+    };
+    let mut next = now.clone();
+    for &i in &tr {
+        let x = triplet(&now.q, i) + V3::new(at(i), at(i + 1), at(i + 2));
+        let v = motion.spin.cross(&(x - motion.center)) + motion.v0;
+        for c in 0..3 {
+            next.q[i + c] = x[c];
+            next.v[i + c] = v[c];
+        }
+    }
+    for (k, &r) in sys.rotations.iter().enumerate() {
+        let turn = exp(&V3::new(at(r), at(r + 1), at(r + 2)));
+        let m = orthonormalize(&(turn * now.rot[k].matrix()));
+        next.rot[k].set_matrix(&m);
+    }
+    for &a in &angles {
+        next.q[a] += at(a);
+    }
+    next
 }

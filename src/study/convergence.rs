@@ -3,9 +3,9 @@
 
 use super::compare::{observed_order, relative_error, Order, Reference, Samples};
 use super::{cell, Compile, IntegratorItem};
-use crate::model::Overrides;
 use crate::output::charts::{Chart, Series};
 use crate::runtime::timefn::TimeFn;
+use crate::settings::Request;
 use std::io::{self, Write};
 
 /// What the runs are compared with (`--reference`).
@@ -65,17 +65,17 @@ pub struct Convergence {
 }
 
 /// Runs the study: `base` holds the command line's other overrides.
-pub fn convergence(spec: &ConvergenceSpec, base: &Overrides, compile: &Compile) -> Convergence {
-    let mut jobs: Vec<(Overrides, usize)> = Vec::new();
+pub fn convergence(spec: &ConvergenceSpec, base: &Request, compile: &Compile) -> Convergence {
+    let mut jobs: Vec<(Request, usize)> = Vec::new();
     for item in &spec.integrators {
         for &n in &spec.steps {
-            jobs.push((item.overrides(base), n));
+            jobs.push((item.request(base), n));
         }
     }
     let finest_steps = spec.steps.iter().max().map(|n| 4 * n).unwrap_or(1);
     let first = spec.integrators.first();
     if let (ReferenceSpec::Finest, Some(item)) = (&spec.reference, first) {
-        jobs.push((item.overrides(base), finest_steps));
+        jobs.push((item.request(base), finest_steps));
     }
     let mut measured = super::measure_all(compile, &jobs, &spec.channel);
     let (reference, finest) = match &spec.reference {

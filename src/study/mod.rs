@@ -16,21 +16,21 @@ pub mod prony;
 pub mod stability;
 pub mod sweep;
 
-use crate::model::{Integrator, Overrides};
+use crate::settings::{self, Method, Request};
 use crate::Compiled;
 use compare::Samples;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// Compiles the model with the given overrides (the `--set` params are the caller's); the
 /// error is a one-line message. Called from worker threads.
-pub type Compile<'a> = dyn Fn(&Overrides) -> Result<Compiled, String> + Sync + 'a;
+pub type Compile<'a> = dyn Fn(&Request) -> Result<Compiled, String> + Sync + 'a;
 
 /// One item of `--integrator LIST`, kept as written for the CSV.
 #[derive(Clone, Debug, PartialEq)]
 pub struct IntegratorItem {
     /// As written: `hht`, `hht:-0.3`, `generalized-alpha:0.5`, `fet`.
     pub text: String,
-    pub integrator: Integrator,
+    pub integrator: Method,
     /// HHT alpha (`hht:ALPHA`), in [-1/3, 0]; `None`: the model's.
     pub alpha: Option<f64>,
     /// Generalized-alpha spectral radius at infinity (`generalized-alpha:RHO`), in [0, 1].
@@ -54,17 +54,17 @@ impl IntegratorItem {
         match (name, arg) {
             ("hht", a) => {
                 let alpha = a
-                    .map(|a| bounded(text, "alpha", a, -1.0 / 3.0, 0.0, "[-1/3, 0]"))
+                    .map(|a| bounded(text, "alpha", a, settings::ALPHA))
                     .transpose()?;
-                Ok(item(Integrator::Hht, alpha, None))
+                Ok(item(Method::Hht, alpha, None))
             }
             ("generalized-alpha" | "generalized_alpha", a) => {
                 let rho = a
-                    .map(|a| bounded(text, "rho_inf", a, 0.0, 1.0, "[0, 1]"))
+                    .map(|a| bounded(text, "rho_inf", a, settings::RHO_INF))
                     .transpose()?;
-                Ok(item(Integrator::GeneralizedAlpha, None, rho))
+                Ok(item(Method::GeneralizedAlpha, None, rho))
             }
-            ("fet", None) => Ok(item(Integrator::Fet, None, None)),
+            ("fet", None) => Ok(item(Method::Fet, None, None)),
             ("fet", Some(_)) => Err(format!("`{text}`: fet takes no parameter")),
             _ => Err(format!(
                 "unknown integrator `{text}`; the items are hht, hht:ALPHA (e.g. hht:-0.3), generalized-alpha, generalized-alpha:RHO_INF (e.g. generalized-alpha:0.5) and fet"
@@ -73,29 +73,22 @@ impl IntegratorItem {
     }
 
     /// `base` with this integrator setting.
-    pub fn overrides(&self, base: &Overrides) -> Overrides {
+    pub fn request(&self, base: &Request) -> Request {
         let mut o = base.clone();
-        o.integrator = Some(self.integrator);
+        o.method = Some(self.integrator);
         o.alpha = self.alpha.or(base.alpha);
         o.rho_inf = self.rho_inf.or(base.rho_inf);
         o
     }
 }
 
-fn bounded(
-    item: &str,
-    what: &str,
-    text: &str,
-    lo: f64,
-    hi: f64,
-    range: &str,
-) -> Result<f64, String> {
+fn bounded(item: &str, what: &str, text: &str, range: settings::Range) -> Result<f64, String> {
     let v: f64 = text
         .trim()
         .parse()
         .map_err(|_| format!("`{item}`: {what} `{text}` is not a number"))?;
-    if !(lo - 1e-12..=hi + 1e-12).contains(&v) {
-        return Err(format!("`{item}`: {what} = {v} is outside {range}"));
+    if !range.contains(v) {
+        return Err(format!("`{item}`: {what} = {v} is outside {}", range.text));
     }
     Ok(v)
 }
@@ -199,7 +192,7 @@ impl Measured {
 }
 
 /// Compiles with `overrides` (every step written) and runs, timing the run alone.
-pub fn measure(compile: &Compile, overrides: &Overrides, channel: &str) -> Measured {
+pub fn measure(compile: &Compile, overrides: &Request, channel: &str) -> Measured {
     let mut o = overrides.clone();
     o.every = Some(1);
     let c = match compile(&o) {
@@ -293,7 +286,7 @@ pub fn parallel<T: Send>(jobs: usize, work: impl Fn(usize) -> T + Sync) -> Vec<O
 }
 
 /// Runs the jobs (`(overrides, channel)` each) in parallel, the costliest (most steps) first.
-fn measure_all(compile: &Compile, jobs: &[(Overrides, usize)], channel: &str) -> Vec<Measured> {
+fn measure_all(compile: &Compile, jobs: &[(Request, usize)], channel: &str) -> Vec<Measured> {
     let mut order: Vec<usize> = (0..jobs.len()).collect();
     order.sort_by_key(|&j| std::cmp::Reverse(jobs[j].1));
     let results = parallel(order.len(), |k| {
@@ -329,12 +322,12 @@ mod tests {
     #[test]
     fn integrator_items_parse_as_written() {
         let hht = IntegratorItem::parse("hht:-0.3").unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((hht.integrator, hht.alpha), (Integrator::Hht, Some(-0.3)));
+        assert_eq!((hht.integrator, hht.alpha), (Method::Hht, Some(-0.3)));
         assert_eq!(hht.text, "hht:-0.3");
         let ga = IntegratorItem::parse("generalized-alpha:0.5").unwrap_or_else(|e| panic!("{e}"));
         assert_eq!(
             (ga.integrator, ga.rho_inf),
-            (Integrator::GeneralizedAlpha, Some(0.5))
+            (Method::GeneralizedAlpha, Some(0.5))
         );
         assert!(IntegratorItem::parse("fet").is_ok());
         for bad in [

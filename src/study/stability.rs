@@ -22,8 +22,8 @@
 
 use super::compare::Samples;
 use super::{cell, measure_all, Compile};
-use crate::model::{Integrator, Overrides};
 use crate::output::charts::{Chart, Series};
+use crate::settings::{Method, Request};
 use std::io::{self, Write};
 
 /// The detector's parameters (the module's doc explains them).
@@ -148,12 +148,12 @@ pub struct StabilityRow {
 }
 
 /// Runs HHT at each alpha and step count, in parallel.
-pub fn stability(spec: &StabilitySpec, base: &Overrides, compile: &Compile) -> Vec<StabilityRow> {
+pub fn stability(spec: &StabilitySpec, base: &Request, compile: &Compile) -> Vec<StabilityRow> {
     let mut jobs = Vec::new();
     for &alpha in &spec.alphas {
         for &n in &spec.steps {
             let mut o = base.clone();
-            o.integrator = Some(Integrator::Hht);
+            o.method = Some(Method::Hht);
             o.alpha = Some(alpha);
             jobs.push((o, n));
         }

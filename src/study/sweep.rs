@@ -170,7 +170,7 @@ pub fn grid(start: f64, stop: f64, step: f64) -> Result<Vec<f64>, String> {
 /// The period of the model's steady rotation: `2 pi / |Omega|` of its revolute joints driven
 /// at a constant rate, if they share one speed.
 pub fn rotor_period(c: &Compiled) -> Result<f64, String> {
-    let until = c.model.solve.until;
+    let until = c.settings.until;
     let mut speeds: Vec<(String, f64)> = Vec::new();
     for j in &c.model.joints {
         if let JointKind::Revolute {
@@ -288,7 +288,7 @@ fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Result<(Vec<c64>, String), S
         Some(t) => t,
         None => rotor_period(c)?,
     };
-    let f = floquet::floquet(&l.system, &c.settings(), period, &|| {}).map_err(|f| {
+    let f = floquet::floquet(&l.system, &c.settings, period, &|| {}).map_err(|f| {
         let d = c.failure_diagnostic(&f.failure);
         format!("{} {} (in {})", d.code.as_str(), d.message, f.which())
     })?;
@@ -302,16 +302,11 @@ fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Result<(Vec<c64>, String), S
 }
 
 fn prony_point(spec: &SweepSpec, mut c: Compiled) -> Result<(Vec<c64>, String), String> {
-    let until = c.model.solve.until;
+    let until = c.settings.until;
     let (from, to) = spec.window.unwrap_or((0.1 * until, until));
-    let dt = c.model.solve.dt;
+    let dt = c.settings.dt;
     let every = (((to - from) / dt / spec.samples.max(12) as f64).floor() as usize).max(1);
-    c.model.solve.every = every;
-    let need = ((to / dt) * (1.0 - 1e-12)).ceil().max(1.0) as usize;
-    if need < c.model.solve.steps {
-        c.model.solve.steps = need;
-        c.model.solve.until = need as f64 * dt;
-    }
+    c.settings = c.settings.ending_by(to, every);
     let mut out = Vec::new();
     let run = crate::run(&c, &mut out);
     if let Err(f) = &run {

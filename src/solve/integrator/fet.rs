@@ -22,10 +22,9 @@
 //! constraints (massless directions: the revolute angles through their rows); output
 //! accelerations are the element's mean `(V_{n+1} - V_n)/h`; output multipliers the element's.
 
-use super::{Integrator, StepFailure};
+use super::{Integrator, Norms, StepFailure};
 use crate::runtime::rotation as rot;
 use crate::runtime::{Augment, Rate, TangentCoeffs, UnknownKind};
-use crate::solve::newton::Newton;
 use crate::solve::FailureKind;
 
 impl Integrator<'_> {
@@ -52,131 +51,121 @@ impl Integrator<'_> {
         }
     }
 
-    /// One time element of size `h` from `cur`; on success `cur` holds the end state.
-    pub(super) fn attempt_fet(&mut self, h: f64) -> Result<(), StepFailure> {
-        let aug = self.scaling(h);
-        let aug_mid = Augment { p: 0.0, ..aug };
-        let rescale = self.aug.s / aug.s;
-        let n = self.sys.len();
-        // Predictor: Taylor to second order from the current rates.
-        {
-            let (sys, cur, tr, mid) = (self.sys, &self.cur, &mut self.trial, &mut self.mid);
-            tr.t = cur.t + h;
-            mid.t = cur.t + 0.5 * h;
-            for (i, k) in sys.unknowns.iter().enumerate() {
-                tr.lambda[i] = 0.0;
-                match k {
-                    UnknownKind::Coordinate => {
-                        tr.q[i] = cur.q[i] + h * cur.v[i] + 0.5 * h * h * cur.a[i];
-                    }
-                    UnknownKind::Multiplier | UnknownKind::RateMultiplier => {
-                        mid.lambda[i] = cur.lambda[i] * rescale;
-                    }
-                    UnknownKind::Rotation { .. } => {}
+    /// Predictor: Taylor to second order from the current rates; the multipliers carried
+    /// over at the new scaling.
+    pub(super) fn fet_predict(&mut self, h: f64, rescale: f64) {
+        let (sys, cur, tr, mid) = (self.sys, &self.cur, &mut self.trial, &mut self.mid);
+        tr.t = cur.t + h;
+        mid.t = cur.t + 0.5 * h;
+        for (i, k) in sys.unknowns.iter().enumerate() {
+            tr.lambda[i] = 0.0;
+            match k {
+                UnknownKind::Coordinate => {
+                    tr.q[i] = cur.q[i] + h * cur.v[i] + 0.5 * h * h * cur.a[i];
                 }
-            }
-            for k in 0..sys.rotations.len() {
-                let th = h * cur.rot[k].omega() + 0.5 * h * h * cur.rot[k].omega_dot();
-                tr.rot[k].set_matrix(&(rot::exp(&th) * cur.rot[k].matrix()));
+                UnknownKind::Multiplier | UnknownKind::RateMultiplier => {
+                    mid.lambda[i] = cur.lambda[i] * rescale;
+                }
+                UnknownKind::Rotation { .. } => {}
             }
         }
+        for k in 0..sys.rotations.len() {
+            let th = h * cur.rot[k].omega() + 0.5 * h * h * cur.rot[k].omega_dot();
+            tr.rot[k].set_matrix(&(rot::exp(&th) * cur.rot[k].matrix()));
+        }
+    }
+
+    /// The element's residual (momentum balance at the mid-configuration, the joints at the
+    /// end), in `rhs`, and its norms.
+    pub(super) fn fet_residual(
+        &mut self,
+        h: f64,
+        aug: Augment,
+        floor: f64,
+    ) -> Result<Norms, StepFailure> {
+        let n = self.sys.len();
+        self.fet_mid(h);
+        self.asm
+            .residual(self.sys, &self.mid, Augment { p: 0.0, ..aug });
+        self.asm.momentum(self.sys, &self.mid);
+        self.asm
+            .joint_residual(self.sys, &self.trial, aug, &mut self.end_res);
+        let (r, e) = (&self.asm.residual, &self.end_res);
+        let (pm, g) = (&self.asm.momentum, &self.asm.transport);
+        let (mut scale, mut cnorm) = (floor, 0.0f64);
+        let (mut rnorm, mut worst) = (0.0f64, (0.0f64, 0usize));
+        for i in 0..n {
+            let (ri, size) = match self.sys.unknowns[i] {
+                UnknownKind::Multiplier => (-aug.s * e.constraint[i], e.constraint[i].abs()),
+                UnknownKind::RateMultiplier => (-aug.s * r.constraint[i], r.constraint[i].abs()),
+                _ => {
+                    let rate = 2.0 * (pm[i] - self.cur.alg[i]) / h;
+                    let f = g[i] + r.force[i] + e.force[i];
+                    scale = scale.max(rate.abs()).max(g[i].abs()).max(r.force[i].abs());
+                    let ri = -(rate + f);
+                    rnorm = rnorm.max(ri.abs());
+                    (ri, ri.abs())
+                }
+            };
+            if self.sys.unknowns[i].is_multiplier() {
+                cnorm = cnorm.max(size);
+            }
+            if !ri.is_finite() {
+                return Err(StepFailure {
+                    kind: FailureKind::NonFinite,
+                    entity: Some(self.sys.owners[i]),
+                    detail: "the residual became NaN or infinite".to_string(),
+                });
+            }
+            if size > worst.0 {
+                worst = (size, i);
+            }
+            self.rhs[i] = ri;
+        }
+        Ok(Norms {
+            force: rnorm,
+            scale,
+            constraint: cnorm,
+            worst: worst.1,
+        })
+    }
+
+    /// The iteration matrix: the element tangent at the mid-configuration with coefficients
+    /// `(2/h^2, 1/h, 1/2)`, the constraint rows and penalty from the end configuration.
+    pub(super) fn fet_matrix(&mut self, h: f64, aug: Augment) {
         let coeffs = TangentCoeffs {
             mass: 2.0 / (h * h),
             velocity: 1.0 / h,
             position: 0.5,
             force_weight: 1.0,
         };
-        let mut newton = Newton::new(&self.set, self.sys);
-        for it in 0..=self.set.max_iterations {
-            self.fet_mid(h);
-            self.asm.residual(self.sys, &self.mid, aug_mid);
-            self.asm.momentum(self.sys, &self.mid);
-            self.asm
-                .joint_residual(self.sys, &self.trial, aug, &mut self.end_res);
-            let (r, e) = (&self.asm.residual, &self.end_res);
-            let (pm, g) = (&self.asm.momentum, &self.asm.transport);
-            let (mut scale, mut cnorm) = (newton.floor, 0.0f64);
-            let (mut rnorm, mut worst) = (0.0f64, (0.0f64, 0usize));
-            for i in 0..n {
-                let (ri, size) = match self.sys.unknowns[i] {
-                    UnknownKind::Multiplier => (-aug.s * e.constraint[i], e.constraint[i].abs()),
-                    UnknownKind::RateMultiplier => {
-                        (-aug.s * r.constraint[i], r.constraint[i].abs())
-                    }
-                    _ => {
-                        let rate = 2.0 * (pm[i] - self.cur.alg[i]) / h;
-                        let f = g[i] + r.force[i] + e.force[i];
-                        scale = scale.max(rate.abs()).max(g[i].abs()).max(r.force[i].abs());
-                        let ri = -(rate + f);
-                        rnorm = rnorm.max(ri.abs());
-                        (ri, ri.abs())
-                    }
-                };
-                if self.sys.unknowns[i].is_multiplier() {
-                    cnorm = cnorm.max(size);
-                }
-                if !ri.is_finite() {
-                    return Err(StepFailure {
-                        kind: FailureKind::NonFinite,
-                        entity: Some(self.sys.owners[i]),
-                        detail: "the residual became NaN or infinite".to_string(),
-                    });
-                }
-                if size > worst.0 {
-                    worst = (size, i);
-                }
-                self.rhs[i] = ri;
+        let aug_mid = Augment { p: 0.0, ..aug };
+        self.asm
+            .tangent_split(self.sys, &self.mid, &self.trial, aug_mid, aug, coeffs);
+    }
+
+    /// Applies the correction in `rhs` to the element's multipliers and end configuration;
+    /// the largest scaled increment.
+    pub(super) fn fet_correct(&mut self) -> f64 {
+        let n = self.sys.len();
+        let mut dmax = 0.0f64;
+        for i in 0..n {
+            let d = self.rhs[i];
+            match self.sys.unknowns[i] {
+                UnknownKind::Multiplier | UnknownKind::RateMultiplier => self.mid.lambda[i] += d,
+                UnknownKind::Rotation { .. } => dmax = dmax.max(d.abs()),
+                UnknownKind::Coordinate => dmax = dmax.max(d.abs() / self.sys.length_scale),
             }
-            if newton.converged(rnorm, scale, cnorm) {
-                self.stats.newton_iterations += it;
-                self.stats.max_constraint_violation =
-                    self.stats.max_constraint_violation.max(cnorm);
-                self.aug = aug;
-                return self.fet_finish(h);
-            }
-            let max = self.set.max_iterations;
-            let total = rnorm + aug.s * cnorm;
-            let norms = (rnorm, scale, cnorm);
-            if let Some(detail) = newton.check(it, max, total, norms, " of the time element") {
-                return Err(StepFailure {
-                    kind: FailureKind::NewtonDiverged,
-                    entity: Some(self.sys.owners[worst.1]),
-                    detail,
-                });
-            }
-            self.asm
-                .tangent_split(self.sys, &self.mid, &self.trial, aug_mid, aug, coeffs);
-            self.lu
-                .factor(&self.asm.values)
-                .map_err(|e| self.singular(e))?;
-            self.lu.solve(&mut self.rhs).map_err(|e| self.singular(e))?;
-            self.limit_turn();
-            let mut dmax = 0.0f64;
-            for i in 0..n {
-                let d = self.rhs[i];
-                match self.sys.unknowns[i] {
-                    UnknownKind::Multiplier | UnknownKind::RateMultiplier => {
-                        self.mid.lambda[i] += d
-                    }
-                    UnknownKind::Rotation { .. } => dmax = dmax.max(d.abs()),
-                    UnknownKind::Coordinate => dmax = dmax.max(d.abs() / self.sys.length_scale),
-                }
-            }
-            let dx = std::mem::take(&mut self.rhs);
-            self.apply_physical(&dx, 0);
-            self.rhs = dx;
-            newton.record(dmax);
         }
-        Err(StepFailure {
-            kind: FailureKind::NewtonDiverged,
-            entity: None,
-            detail: "Newton did not converge".to_string(),
-        })
+        let dx = std::mem::take(&mut self.rhs);
+        self.apply_physical(&dx, 0);
+        self.rhs = dx;
+        dmax
     }
 
     /// After convergence (the momenta of the mid-configuration in `asm.momentum`): the end
     /// momenta, output velocities, accelerations and multipliers; `trial` becomes current.
-    fn fet_finish(&mut self, h: f64) -> Result<(), StepFailure> {
+    pub(super) fn fet_commit(&mut self, h: f64) -> Result<(), StepFailure> {
         let n = self.sys.len();
         for i in 0..n {
             if !self.sys.unknowns[i].is_multiplier() {

@@ -1,0 +1,402 @@
+//! The time integrators on one assembly, one sparse LU and one Newton loop (THEORY §6-§8):
+//! HHT-alpha and generalized-alpha ([`newmark`]), statics' load steps ([`statics`]), time
+//! finite elements ([`fet`]); the consistent start ([`start`], on the constrained mass matrix
+//! of [`start_matrix`]); the linearized equations for modes and Floquet ([`linearize`]).
+//!
+//! This file holds what they share: the integrator's state and workspace, the time loop
+//! ([`Integrator::run`]), step halving, the Newton loop of one step (predict, residual and
+//! norms, iteration matrix, correction, commit: each method supplies its own), the
+//! augmented-Lagrangian scaling and the failures.
+//!
+//! Rotations (THEORY §2.7, §7.1): [`Layout`] says how the rotation unknowns are held.
+
+mod fet;
+mod linearize;
+mod newmark;
+mod start;
+mod start_matrix;
+mod statics;
+
+pub use linearize::Linearization;
+
+use super::linear::{LinearError, SparseLu};
+use super::newton::Newton;
+use super::rotations::Transform;
+use super::{FailureKind, Method, Rotations, RunStats, RuntimeFailure, Settings};
+use crate::runtime::rotation::{M3, V3};
+use crate::runtime::{Assembler, Augment, Residual, State, System};
+use newmark::Scheme;
+use start_matrix::StartMetric;
+
+/// Largest rotation of a node in one Newton correction (rad).
+const MAX_TURN: f64 = 0.5;
+
+/// How the rotation unknowns are held.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Layout {
+    /// Stored rotations moved by body-frame increments: rigid bodies as SE(3) frames, beam
+    /// nodes as SO(3) x R3 ([`super::se3`]); the Newmark family with `Rotations::Incremental`.
+    Increments,
+    /// The total conformal rotation vector as the unknown, with its rates
+    /// ([`super::rotations`]); the Newmark family with `Rotations::Conformal`.
+    Conformal,
+    /// Virtual rotations, the state in the physical layout: time finite elements.
+    Physical,
+}
+
+/// The norms of a residual: forces, their scale, the constraint violation, and the unknown
+/// with the largest scaled entry.
+#[derive(Clone, Copy, Debug)]
+struct Norms {
+    force: f64,
+    scale: f64,
+    constraint: f64,
+    worst: usize,
+}
+
+/// What stopped [`Integrator::run`]: a failed step, or the caller.
+#[derive(Debug)]
+pub enum Stop<E> {
+    Failed(RuntimeFailure),
+    Stopped(E),
+}
+
+pub struct Integrator<'s> {
+    sys: &'s System,
+    set: Settings,
+    sc: Scheme,
+    /// The method (the settings'), and how rotations are held.
+    method: Method,
+    layout: Layout,
+    /// FET: the mid-configuration of the step (constant velocities, the multipliers).
+    mid: State,
+    /// FET: the joints' residual at the end configuration.
+    end_res: Residual,
+    asm: Assembler,
+    lu: SparseLu,
+    /// `T^T J T` on the blocks: rotation unknowns with `H(c)` (conformal), or translation and
+    /// rotation unknowns of each node with `R` (incremental, SE(3)).
+    transform: Transform,
+    blocks: Vec<usize>,
+    /// Block matrices for the rows (`H(c)` or `R`) and for the columns (`H(c)`, or
+    /// `R J_r^-1(increment)`, which accounts for the increment's dependence on the correction).
+    mats: Vec<M3>,
+    cols: Vec<M3>,
+    /// Unknowns moved by the SE(3) node updates instead of Newmark on coordinates.
+    in_frame: Vec<bool>,
+    /// The converged state at the current time.
+    cur: State,
+    /// The iterate of the step being solved.
+    trial: State,
+    rhs: Vec<f64>,
+    /// The right-hand side kept while the constrained mass matrix is solved (FET solves it
+    /// every step), to retry after [`StartMetric::widen`] without allocating.
+    mass_rhs: Vec<f64>,
+    /// Scaling used for the current step and for `cur.lambda`.
+    aug: Augment,
+    stats: RunStats,
+    /// Index of the step being taken (for messages).
+    step_index: usize,
+    /// The rotating node of each transformed block.
+    block_node: Vec<usize>,
+    /// The constrained mass matrix of the start: plain, or with the stiffness on the massless
+    /// motions that no joint holds ([`start_matrix`]).
+    start: StartMetric,
+}
+
+/// Why a step attempt failed, before it is turned into a [`RuntimeFailure`].
+pub(super) struct StepFailure {
+    kind: FailureKind,
+    entity: Option<usize>,
+    detail: String,
+}
+
+impl<'s> Integrator<'s> {
+    pub fn new(sys: &'s System, set: &Settings) -> Result<Integrator<'s>, RuntimeFailure> {
+        let asm = Assembler::new(sys);
+        let setup = |detail: String| RuntimeFailure {
+            kind: FailureKind::Singular,
+            t: 0.0,
+            step: 0,
+            entity: None,
+            detail,
+        };
+        let lu = SparseLu::new(&asm.pattern)
+            .map_err(|e| setup(format!("the sparse LU could not be set up ({e:?})")))?;
+        // FET integrates rotations incrementally (THEORY §8.1) whatever the treatment.
+        let layout = match (set.method, set.rotations) {
+            (Method::Fet, _) => Layout::Physical,
+            (_, Rotations::Conformal) => Layout::Conformal,
+            (_, Rotations::Incremental) => Layout::Increments,
+        };
+        let n = sys.len();
+        // Transformed 3x3 blocks and the rotating node of each.
+        let nodes = sys.rotations.len();
+        let (blocks, block_node): (Vec<usize>, Vec<usize>) = if layout == Layout::Conformal {
+            (sys.rotations.clone(), (0..nodes).collect())
+        } else {
+            (0..nodes)
+                .filter(|&k| sys.is_frame(k))
+                .map(|k| (sys.translations[k], k))
+                .chain((0..nodes).map(|k| (sys.rotations[k], k)))
+                .unzip()
+        };
+        let transform = Transform::new(n, &blocks, &asm.pattern).ok_or_else(|| {
+            setup("internal: a rotating node's unknowns are not coupled as a block".into())
+        })?;
+        let mut in_frame = vec![false; n];
+        if layout == Layout::Increments {
+            for &f in &blocks {
+                in_frame[f..f + 3].iter_mut().for_each(|x| *x = true);
+            }
+        }
+        let mut it = Integrator {
+            sys,
+            set: set.clone(),
+            sc: Scheme::of(set),
+            method: set.method,
+            layout,
+            mid: sys.initial.clone(),
+            end_res: Residual::new(n),
+            asm,
+            lu,
+            transform,
+            mats: vec![M3::identity(); blocks.len()],
+            cols: vec![M3::identity(); blocks.len()],
+            blocks,
+            block_node,
+            in_frame,
+            cur: sys.initial.clone(),
+            trial: sys.initial.clone(),
+            rhs: vec![0.0; n],
+            mass_rhs: vec![0.0; n],
+            aug: Augment {
+                s: 1.0,
+                p: 1.0,
+                rate_scale: 1.0,
+            },
+            stats: RunStats::default(),
+            step_index: 0,
+            start: StartMetric::default(),
+        };
+        it.aug = it.scaling(set.dt);
+        Ok(it)
+    }
+
+    pub fn state(&self) -> &State {
+        &self.cur
+    }
+
+    pub fn augment(&self) -> Augment {
+        self.aug
+    }
+
+    pub fn stats(&self) -> &RunStats {
+        &self.stats
+    }
+
+    /// `s = p = m/(beta h^2) + k` (THEORY §6); rate rows scaled by `beta h / gamma`.
+    fn scaling(&self, h: f64) -> Augment {
+        let inertia = self.sys.mean_mass() / (self.sc.beta * h * h);
+        let k = if self.method == Method::Static && self.sys.mean_stiffness() > 0.0 {
+            self.sys.mean_stiffness()
+        } else {
+            inertia + self.sys.mean_stiffness()
+        };
+        Augment {
+            s: k,
+            p: k,
+            // FET: the constant velocity of the element moves by 1/h per unit correction.
+            rate_scale: if self.method == Method::Fet {
+                h
+            } else {
+                self.sc.beta * h / self.sc.gamma
+            },
+        }
+    }
+
+    fn ctol(&self) -> f64 {
+        self.set.increment_tolerance * self.sys.length_scale
+    }
+
+    fn fail(&self, f: StepFailure) -> RuntimeFailure {
+        RuntimeFailure {
+            kind: f.kind,
+            t: self.cur.t,
+            step: self.step_index,
+            entity: f.entity,
+            detail: f.detail,
+        }
+    }
+
+    fn is_mult(&self, i: usize) -> bool {
+        self.sys.unknowns[i].is_multiplier()
+    }
+
+    fn singular(&self, e: LinearError) -> StepFailure {
+        StepFailure {
+            kind: FailureKind::Singular,
+            entity: None,
+            detail: format!("the iteration matrix could not be factored ({e:?}); a body may lack mass in some direction, or joints may be redundant"),
+        }
+    }
+
+    fn check_finite(&self) -> Result<(), StepFailure> {
+        let bad = self
+            .cur
+            .first_non_finite()
+            .map(|i| self.sys.owners[i])
+            .or_else(|| {
+                self.cur
+                    .first_non_finite_node()
+                    .map(|k| self.sys.owners[self.sys.rotations[k]])
+            });
+        match bad {
+            Some(e) => Err(StepFailure {
+                kind: FailureKind::NonFinite,
+                entity: Some(e),
+                detail: "the state became NaN or infinite".to_string(),
+            }),
+            None => Ok(()),
+        }
+    }
+
+    /// Integrates the settings' `steps` steps of `dt` from the current state, calling
+    /// `each(k, self)` after step `k` (with the time set to `t0 + k dt`, free of accumulated
+    /// round-off). Stops at a step that fails, or when `each` returns an error.
+    pub fn run<E>(
+        &mut self,
+        mut each: impl FnMut(usize, &Self) -> Result<(), E>,
+    ) -> Result<(), Stop<E>> {
+        let (t0, dt) = (self.cur.t, self.set.dt);
+        for k in 1..=self.set.steps {
+            self.step(k, dt).map_err(Stop::Failed)?;
+            self.cur.t = t0 + k as f64 * dt;
+            each(k, self).map_err(Stop::Stopped)?;
+        }
+        Ok(())
+    }
+
+    /// Advances from the current state by `h` (halving the step on failure).
+    fn step(&mut self, index: usize, h: f64) -> Result<(), RuntimeFailure> {
+        self.step_index = index;
+        self.advance(h, 0).map_err(|f| self.fail(f))?;
+        self.stats.steps += 1;
+        Ok(())
+    }
+
+    fn advance(&mut self, h: f64, depth: usize) -> Result<(), StepFailure> {
+        match self.attempt(h) {
+            Ok(()) => Ok(()),
+            Err(f) if depth >= self.set.max_halvings => Err(f),
+            Err(_) => {
+                self.stats.halvings += 1;
+                // Failure path only: keep a copy to restore if the halves fail too.
+                let backup = (self.cur.clone(), self.aug);
+                let result = self
+                    .advance(h / 2.0, depth + 1)
+                    .and_then(|_| self.advance(h / 2.0, depth + 1));
+                match result {
+                    Ok(()) => Ok(()),
+                    Err(mut f) => {
+                        (self.cur, self.aug) = backup;
+                        if depth == 0 {
+                            let levels = self.set.max_halvings;
+                            f.detail.push_str(&if levels == 1 {
+                                "; the step was retried at half of its size and failed again"
+                                    .to_string()
+                            } else {
+                                format!(
+                                    "; the step was retried in halves down to 1/{} of its size and failed again",
+                                    1usize << levels
+                                )
+                            });
+                        }
+                        Err(f)
+                    }
+                }
+            }
+        }
+    }
+
+    /// A correction in `rhs` that turns some node by more than half a radian is outside the
+    /// reach of the linearization (and can jump to a rotation increment on another branch of
+    /// the logarithm): scales the whole correction down to that size.
+    fn limit_turn(&mut self) {
+        let mut turn = 0.0f64;
+        for &r in &self.sys.rotations {
+            let d = V3::new(self.rhs[r], self.rhs[r + 1], self.rhs[r + 2]);
+            turn = turn.max(d.norm());
+        }
+        if turn > MAX_TURN {
+            let f = MAX_TURN / turn;
+            self.rhs.iter_mut().for_each(|x| *x *= f);
+        }
+    }
+
+    /// One step of size `h` from `cur` by the method's Newton iteration; on success `cur`
+    /// holds the new state.
+    fn attempt(&mut self, h: f64) -> Result<(), StepFailure> {
+        let aug = self.scaling(h);
+        let rescale = self.aug.s / aug.s;
+        let fet = self.method == Method::Fet;
+        if fet {
+            self.fet_predict(h, rescale);
+        } else {
+            self.newmark_predict(h, rescale);
+        }
+        let mut newton = Newton::new(&self.set, self.sys);
+        let max = self.set.max_iterations;
+        for it in 0..=max {
+            let r = if fet {
+                self.fet_residual(h, aug, newton.floor)?
+            } else {
+                self.newmark_residual(aug, newton.floor)?
+            };
+            if newton.converged(r.force, r.scale, r.constraint) {
+                self.stats.newton_iterations += it;
+                self.stats.max_constraint_violation =
+                    self.stats.max_constraint_violation.max(r.constraint);
+                self.aug = aug;
+                return if fet {
+                    self.fet_commit(h)
+                } else {
+                    self.newmark_commit()
+                };
+            }
+            let total = r.force + aug.s * r.constraint;
+            let what = if fet { " of the time element" } else { "" };
+            let norms = (r.force, r.scale, r.constraint);
+            if let Some(detail) = newton.check(it, max, total, norms, what) {
+                return Err(StepFailure {
+                    kind: FailureKind::NewtonDiverged,
+                    entity: Some(self.sys.owners[r.worst]),
+                    detail,
+                });
+            }
+            if fet {
+                self.fet_matrix(h, aug);
+            } else {
+                self.newmark_matrix(h, aug);
+            }
+            self.lu
+                .factor(&self.asm.values)
+                .map_err(|e| self.singular(e))?;
+            self.lu.solve(&mut self.rhs).map_err(|e| self.singular(e))?;
+            if self.layout != Layout::Conformal {
+                self.limit_turn();
+            }
+            let dmax = if fet {
+                self.fet_correct()
+            } else {
+                self.newmark_correct(h)
+            };
+            newton.record(dmax);
+        }
+        Err(StepFailure {
+            kind: FailureKind::NewtonDiverged,
+            entity: None,
+            detail: "Newton did not converge".to_string(),
+        })
+    }
+}

@@ -1,0 +1,330 @@
+//! The Newmark family in the Arnold-Bruls form: HHT-alpha and generalized-alpha (and the
+//! load steps of statics, which share its residual and correction): predictor, residual and
+//! norms, iteration matrix, correction and commit of one Newton step.
+//!
+//! Both in the Arnold-Bruls form: the balance `F^I + F^int + F^c - F^ext = 0` and `s C = 0`
+//! at `t_{n+1}`, with Newmark relations on algorithmic accelerations `A`,
+//! `(1 - a_m) A_{n+1} + a_m A_n = (1 - a_f) a_{n+1} + a_f a_n`.
+//! HHT: `a_m = 0`, `a_f = -alpha`, `beta = (1 - alpha)^2 / 4`, `gamma = 1/2 - alpha`: the same
+//! amplification as THEORY §7.2's force-weighted form on linear problems (spectral radius at
+//! infinity `(1 + alpha)/(1 - alpha)`), and second order with configuration-dependent inertia,
+//! where the force-weighted form with `F^I` at `t_{n+1}` was measured first order (a free
+//! rigid body with an offset centre of mass). Generalized-alpha: `a_m`, `a_f`, `beta`, `gamma`
+//! from `rho_inf` (THEORY §7.5).
+//!
+//! Rotations: with the incremental treatment each rotating node is an SE(3) frame updated by
+//! body-frame increments ([`crate::solve::se3`]); with the conformal treatment the rotation
+//! unknowns hold `c`, `c-dot`, `c-ddot` like any coordinate ([`crate::solve::rotations`]).
+
+use super::{Integrator, Layout, Norms, StepFailure};
+use crate::runtime::rotation::{self as rot};
+use crate::runtime::{Augment, TangentCoeffs, UnknownKind};
+use crate::settings::{Method, Settings};
+use crate::solve::{rotations, se3, FailureKind};
+
+/// The scheme's constants.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Scheme {
+    pub(super) am: f64,
+    pub(super) af: f64,
+    pub(super) beta: f64,
+    pub(super) gamma: f64,
+}
+
+impl Scheme {
+    pub(super) fn of(set: &Settings) -> Scheme {
+        match set.method {
+            Method::GeneralizedAlpha => {
+                let r = set.rho_inf;
+                let am = (2.0 * r - 1.0) / (r + 1.0);
+                let af = r / (r + 1.0);
+                Scheme {
+                    am,
+                    af,
+                    gamma: 0.5 - am + af,
+                    beta: 0.25 * (1.0 - am + af).powi(2),
+                }
+            }
+            // Time finite elements: the trapezoidal constants size the constraint scaling
+            // (`s = 4 m / h^2 + k`) and the start.
+            Method::Fet => Scheme {
+                am: 0.0,
+                af: 0.0,
+                beta: 0.25,
+                gamma: 0.5,
+            },
+            // HHT in the Arnold-Bruls form: equations at t_{n+1}, a_m = 0, a_f = -alpha. Same
+            // linear amplification as the force-weighted form, and second order with
+            // configuration-dependent inertia (the weighted form is first order there). Statics
+            // takes these constants for its scaling and start.
+            _ => Scheme {
+                am: 0.0,
+                af: -set.alpha,
+                beta: (1.0 - set.alpha).powi(2) / 4.0,
+                gamma: 0.5 - set.alpha,
+            },
+        }
+    }
+
+    /// `d a_{n+1} / d q_{n+1}`.
+    fn mass_coefficient(&self, h: f64) -> f64 {
+        (1.0 - self.am) / ((1.0 - self.af) * self.beta * h * h)
+    }
+}
+
+impl Integrator<'_> {
+    /// Predictor: the acceleration `a_{n+1} = a_n` (statics: the previous load step's
+    /// equilibrium); the multipliers carried over at the new scaling.
+    pub(super) fn newmark_predict(&mut self, h: f64, rescale: f64) {
+        let sc = self.sc;
+        let hold = self.method == Method::Static;
+        let n = self.sys.len();
+        let (cur, tr) = (&self.cur, &mut self.trial);
+        tr.t = cur.t + h;
+        let step = |v: f64, a: f64, alg0: f64| {
+            let alg = (a - sc.am * alg0) / (1.0 - sc.am);
+            if hold {
+                0.0
+            } else {
+                h * v + h * h * ((0.5 - sc.beta) * alg0 + sc.beta * alg)
+            }
+        };
+        for i in 0..n {
+            if self.sys.unknowns[i].is_multiplier() {
+                tr.lambda[i] = cur.lambda[i] * rescale;
+            } else {
+                tr.lambda[i] = 0.0;
+                if !self.in_frame[i] {
+                    tr.q[i] = cur.q[i] + step(cur.v[i], cur.a[i], cur.alg[i]);
+                }
+            }
+        }
+        if self.layout == Layout::Increments {
+            for k in 0..self.sys.rotations.len() {
+                let f = cur.frames[k];
+                let d: [f64; 6] = std::array::from_fn(|j| step(f.v[j], f.dv[j], f.alg[j]));
+                se3::displace(self.sys, cur, tr, k, &d);
+            }
+        }
+        self.newmark(h);
+    }
+
+    /// The residual at the iterate, in `rhs` in the treatment's unknowns, and its norms.
+    pub(super) fn newmark_residual(
+        &mut self,
+        aug: Augment,
+        floor: f64,
+    ) -> Result<Norms, StepFailure> {
+        let n = self.sys.len();
+        self.asm.residual(self.sys, &self.trial, aug);
+        self.block_matrices();
+        let r = &self.asm.residual;
+        let (mut scale, mut cnorm) = (floor, 0.0f64);
+        for i in 0..n {
+            if self.sys.unknowns[i].is_multiplier() {
+                cnorm = cnorm.max(r.constraint[i].abs());
+                self.rhs[i] = -aug.s * r.constraint[i];
+            } else {
+                scale = scale.max(r.inertia[i].abs()).max(r.force[i].abs());
+                self.rhs[i] = -(r.inertia[i] + r.force[i]);
+            }
+        }
+        rotations::transform_vector(&self.blocks, &self.mats, &mut self.rhs);
+        let (mut rnorm, mut worst) = (0.0f64, (0.0f64, 0usize));
+        for i in 0..n {
+            let ri = self.rhs[i];
+            if !ri.is_finite() {
+                return Err(StepFailure {
+                    kind: FailureKind::NonFinite,
+                    entity: Some(self.sys.owners[i]),
+                    detail: "the residual became NaN or infinite".to_string(),
+                });
+            }
+            let size = if self.sys.unknowns[i].is_multiplier() {
+                ri.abs() / aug.s
+            } else {
+                rnorm = rnorm.max(ri.abs());
+                ri.abs()
+            };
+            if size > worst.0 {
+                worst = (size, i);
+            }
+        }
+        Ok(Norms {
+            force: rnorm,
+            scale,
+            constraint: cnorm,
+            worst: worst.1,
+        })
+    }
+
+    /// The iteration matrix at the iterate, `T^T J T` in the treatment's unknowns.
+    pub(super) fn newmark_matrix(&mut self, h: f64, aug: Augment) {
+        let sc = self.sc;
+        let coeffs = if self.method == Method::Static {
+            Self::static_coefficients()
+        } else {
+            TangentCoeffs {
+                mass: sc.mass_coefficient(h),
+                velocity: sc.gamma / (sc.beta * h),
+                position: 1.0,
+                force_weight: 1.0,
+            }
+        };
+        self.asm.tangent(self.sys, &self.trial, aug, coeffs);
+        self.transform.apply(
+            &self.asm.pattern,
+            &mut self.asm.values,
+            &self.mats,
+            &self.cols,
+        );
+    }
+
+    /// Applies the correction in `rhs` (multipliers, coordinates, node increments) and
+    /// updates the rates; the largest scaled increment.
+    pub(super) fn newmark_correct(&mut self, h: f64) -> f64 {
+        let n = self.sys.len();
+        let conformal = self.layout == Layout::Conformal;
+        let mut dmax = 0.0f64;
+        let tr = &mut self.trial;
+        for i in 0..n {
+            let d = self.rhs[i];
+            match self.sys.unknowns[i] {
+                UnknownKind::Multiplier | UnknownKind::RateMultiplier => tr.lambda[i] += d,
+                UnknownKind::Rotation { .. } => {
+                    dmax = dmax.max(d.abs());
+                    if conformal {
+                        tr.q[i] += d;
+                    }
+                }
+                UnknownKind::Coordinate => {
+                    dmax = dmax.max(d.abs() / self.sys.length_scale);
+                    if !self.in_frame[i] {
+                        tr.q[i] += d;
+                    }
+                }
+            }
+        }
+        if !conformal {
+            for (k, (&t, &r)) in self
+                .sys
+                .translations
+                .iter()
+                .zip(&self.sys.rotations)
+                .enumerate()
+            {
+                let rhs = &self.rhs;
+                let d = [
+                    rhs[t],
+                    rhs[t + 1],
+                    rhs[t + 2],
+                    rhs[r],
+                    rhs[r + 1],
+                    rhs[r + 2],
+                ];
+                se3::displace_in_place(self.sys, tr, k, &d);
+            }
+        }
+        self.newmark(h);
+        dmax
+    }
+
+    /// The converged iterate becomes current: conformal vectors rescaled past pi, rotation
+    /// matrices re-orthonormalized.
+    pub(super) fn newmark_commit(&mut self) -> Result<(), StepFailure> {
+        std::mem::swap(&mut self.cur, &mut self.trial);
+        if self.layout == Layout::Conformal {
+            self.stats.rescalings += rotations::rescale(self.sys, &mut self.cur);
+            rotations::sync(self.sys, &mut self.cur);
+        } else {
+            for k in 0..self.sys.rotations.len() {
+                let r = rot::orthonormalize(&self.cur.rot[k].matrix());
+                self.cur.rot[k].set_matrix(&r);
+            }
+        }
+        self.check_finite()
+    }
+
+    /// The transform's block matrices at the iterate: `H(c)` (conformal) or `R` for the
+    /// translation and rotation blocks of each node (SE(3)).
+    fn block_matrices(&mut self) {
+        let nodes = self.sys.rotations.len();
+        if self.layout == Layout::Conformal {
+            rotations::tangents(self.sys, &self.trial, &mut self.mats);
+            self.cols.copy_from_slice(&self.mats);
+        } else {
+            // Rotation blocks come last, one per node in order.
+            let first = self.blocks.len() - nodes;
+            for k in 0..nodes {
+                let r = self.trial.rot[k].matrix();
+                self.mats[first + k] = r;
+                let th = rot::log(&(self.cur.rot[k].matrix().transpose() * r));
+                // The correction moves R by exactly R d, and the step increment by
+                // J_r^-1(th) d, on which the Newmark rates depend: R J_r^-1 is exact for the
+                // inertial terms, R for the configuration terms. Beam nodes take R (their
+                // elastic stiffness dominates, and would leak through an O(th) error from stiff
+                // to soft directions), frames R J_r^-1 (their tangent is all inertia; the
+                // constraint columns then carry an O(th) error and Newton converges linearly at
+                // a rate near omega h / 2: the exact SE(3) columns, on branch
+                // `exact-se3-newton`, halve the iterations but lose Newton in the violent
+                // motion of P3 after 15 s at dt = 0.05).
+                self.cols[first + k] = if self.sys.is_frame(k) && self.method != Method::Static {
+                    r * rot::left_jacobian_inverse(&-th)
+                } else {
+                    r
+                };
+            }
+            for b in 0..first {
+                let k = self.block_node[b];
+                self.mats[b] = self.mats[first + k];
+                self.cols[b] = self.cols[first + k];
+            }
+        }
+    }
+
+    /// Updates velocities and accelerations of the iterate from its positions (Newmark).
+    fn newmark(&mut self, h: f64) {
+        if self.method == Method::Static {
+            self.static_rates();
+            return;
+        }
+        let Scheme {
+            am,
+            af,
+            beta,
+            gamma,
+            ..
+        } = self.sc;
+        // (increment, previous rate, previous acceleration, previous algorithmic acceleration)
+        // -> (rate, acceleration, algorithmic acceleration).
+        let relation = |dq: f64, v: f64, a: f64, alg0: f64| {
+            let alg = (dq - h * v - h * h * (0.5 - beta) * alg0) / (beta * h * h);
+            (
+                v + h * ((1.0 - gamma) * alg0 + gamma * alg),
+                ((1.0 - am) * alg + am * alg0 - af * a) / (1.0 - af),
+                alg,
+            )
+        };
+        let (cur, tr) = (&self.cur, &mut self.trial);
+        for i in 0..self.sys.len() {
+            if self.in_frame[i] || self.sys.unknowns[i].is_multiplier() {
+                continue;
+            }
+            let (v, a, alg) = relation(tr.q[i] - cur.q[i], cur.v[i], cur.a[i], cur.alg[i]);
+            (tr.v[i], tr.a[i], tr.alg[i]) = (v, a, alg);
+        }
+        if self.layout == Layout::Conformal {
+            rotations::sync(self.sys, tr);
+            return;
+        }
+        for k in 0..self.sys.rotations.len() {
+            let d = se3::increment(self.sys, cur, tr, k);
+            let f0 = cur.frames[k];
+            let f = &mut tr.frames[k];
+            for j in 0..6 {
+                (f.v[j], f.dv[j], f.alg[j]) = relation(d[j], f0.v[j], f0.dv[j], f0.alg[j]);
+            }
+            se3::to_physical(self.sys, tr, k);
+        }
+    }
+}
