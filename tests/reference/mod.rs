@@ -15,13 +15,16 @@
 //! - Pendulum: theta from the bottom, counterclockwise about +z (the P2 start velocity +x at
 //!   the bottom is `theta' > 0`).
 //!
-//! Layout: `dormand_prince` (the integrator), `two_bar`, `rigid_body` and `pendulum` (the
-//! reduced equations, each integrated with `dopri`), `tests` (their unit tests).
+//! Layout: `dormand_prince` (the integrator); `two_bar`, `rigid_body`, `pendulum` and
+//! `windmill` (the equations of motion, each integrated with `dopri`); `tests` (the unit tests of
+//! the first four). `windmill` is public as a module, since its P5 parameters (`MB`, `E`, ...)
+//! are used by name in `tests/rotor.rs`.
 
 mod dormand_prince;
 mod pendulum;
 mod rigid_body;
 mod two_bar;
+pub mod windmill;
 
 pub use dormand_prince::{dopri, dopri_breaks};
 pub use pendulum::pendulum;
