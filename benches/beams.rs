@@ -13,12 +13,10 @@ use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use mbd::settings::{Method, Request};
 use std::time::Duration;
 
+mod common;
+
 fn source() -> String {
-    std::fs::read_to_string(format!(
-        "{}/models/rotating_beam.mbd",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap_or_default()
+    common::model_text("rotating_beam.mbd")
 }
 
 fn scaling(c: &mut Criterion) {
@@ -81,12 +79,15 @@ fn fig6(c: &mut Criterion) {
         let mut out = Vec::with_capacity(1 << 20);
         if mbd::run(&compiled, &mut out).is_ok() {
             let csv = String::from_utf8_lossy(&out);
-            let last = csv.lines().last().unwrap_or_default();
+            let last = csv
+                .lines()
+                .last()
+                .unwrap_or_else(|| panic!("{label} steps: the run wrote no CSV"));
             let phi: f64 = last
                 .split(',')
                 .nth(1)
                 .and_then(|s| s.trim().parse().ok())
-                .unwrap_or(f64::NAN);
+                .unwrap_or_else(|| panic!("{label} steps: no phi in the last CSV row `{last}`"));
             let pi = std::f64::consts::PI;
             eprintln!("{label} steps: (phi - pi)/pi = {:.3e}", (phi - pi) / pi);
         }

@@ -4,10 +4,7 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbd::settings::Request;
 
-fn model(name: &str) -> String {
-    std::fs::read_to_string(format!("{}/models/{name}.mbd", env!("CARGO_MANIFEST_DIR")))
-        .unwrap_or_default()
-}
+mod common;
 
 fn compile(c: &mut Criterion) {
     for (name, sets) in [
@@ -17,7 +14,7 @@ fn compile(c: &mut Criterion) {
         ("windmill_elastic", vec![]),
         ("rotating_beam", vec!["elements=40".to_string()]),
     ] {
-        let text = model(name);
+        let text = common::model_text(&format!("{name}.mbd"));
         let label = format!("check {name} {}", sets.join(" "));
         c.bench_function(label.trim(), |b| {
             b.iter(|| mbd::compile(name, &text, &sets, Request::default()).is_ok())

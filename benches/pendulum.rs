@@ -3,9 +3,10 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbd::settings::Request;
 
+mod common;
+
 fn pendulum_text() -> String {
-    std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/models/pendulum.mbd"))
-        .unwrap_or_default()
+    common::model_text("pendulum.mbd")
 }
 
 fn compile(c: &mut Criterion) {

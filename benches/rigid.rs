@@ -5,14 +5,11 @@
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbd::settings::{Method, Request, Rotations};
 
-fn text(model: &str) -> String {
-    std::fs::read_to_string(format!("{}/models/{model}", env!("CARGO_MANIFEST_DIR")))
-        .unwrap_or_default()
-}
+mod common;
 
 fn runs(c: &mut Criterion) {
     for model in ["two_bar.mbd", "two_bar_spin.mbd", "pendulum.mbd"] {
-        let source = text(model);
+        let source = common::model_text(model);
         for (name, rotations, integrator) in [
             ("incremental", Rotations::Incremental, Method::Hht),
             ("conformal", Rotations::Conformal, Method::Hht),

@@ -8,16 +8,10 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use mbd::settings::Request;
 use mbd::study::sweep::{self, Method, SweepSpec};
 
-fn text() -> String {
-    std::fs::read_to_string(format!(
-        "{}/models/windmill.mbd",
-        env!("CARGO_MANIFEST_DIR")
-    ))
-    .unwrap_or_default()
-}
+mod common;
 
 fn runs(c: &mut Criterion) {
-    let source = text();
+    let source = common::model_text("windmill.mbd");
     if let Ok(compiled) = mbd::compile("windmill.mbd", &source, &[], Request::default()) {
         let mut out = Vec::with_capacity(1 << 22);
         c.bench_function("windmill: 3 s run, 6000 steps", |b| {

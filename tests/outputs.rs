@@ -164,12 +164,8 @@ fn windmill_center_of_mass_follows_the_hub_and_the_blades() {
     }
 }
 
-#[test]
-fn center_of_mass_weighs_bodies_beams_and_concentrated_masses() {
-    // A floating assembly, spun about z: a rigid plate whose centre of mass is off its
-    // reference point, a free beam whose section's mass is off its axis and that carries a
-    // concentrated mass, and a point mass in a nested instance.
-    let text = "model cm \"A floating assembly\"\n\
+/// The floating assembly of `center_of_mass_weighs_bodies_beams_and_concentrated_masses`.
+const CM_MODEL: &str = "model cm \"A floating assembly\"\n\
 component weight(at: position) {\n\
     point_mass bob { mass = 1 kg, at = at }\n\
 }\n\
@@ -194,6 +190,13 @@ output cm = center_of_mass(a), v = center_of_mass(a).velocity\n\
 output acc = center_of_mass(a).acceleration, plate_x = center_of_mass(a.plate).x\n\
 output center_of_mass(a.tail).position.y\n\
 solve hht { dt = 1 ms, until = 0.05 s }\n";
+
+#[test]
+fn center_of_mass_weighs_bodies_beams_and_concentrated_masses() {
+    // A floating assembly, spun about z: a rigid plate whose centre of mass is off its
+    // reference point, a free beam whose section's mass is off its axis and that carries a
+    // concentrated mass, and a point mass in a nested instance.
+    let text = CM_MODEL;
     let compiled = match mbd::compile("cm.mbd", text, &[], Request::default()) {
         Ok(c) => c,
         Err(f) => panic!("{:?}", f.diagnostics),

@@ -1,8 +1,8 @@
 //! The rigid multibody runtime against independent references (issue 4): a free asymmetric
 //! rigid body against Euler's equations, the two-bar mechanism of P3 and P4 against its reduced
 //! equations, the paper's Fig. 14 stability finding, and the two rotation treatments.
-//! References are integrated here by the adaptive Dormand-Prince code of `reference.rs`
-//! (relative tolerance 1e-12 or tighter).
+//! References are integrated here by the adaptive Dormand-Prince code of
+//! `reference/dormand_prince.rs` (relative tolerance 1e-12 or tighter).
 
 use crate::common::{read, simulate_text, Trace};
 use crate::reference::{free_body, TwoBar, TwoBarState};

@@ -374,6 +374,94 @@ fn failed_runs_keep_their_rows_and_do_not_stop_the_study() {
     assert!(rows.iter().all(|r| r[3].is_empty()));
 }
 
+/// Bad `mbd study` usages (after `study models/pendulum.mbd -o FILE`), each with what its
+/// message says.
+const BAD_USAGE: &[(&[&str], &str)] = &[
+    (
+        &["--channel", "xx", "--integrator", "hht", "--steps", "10"],
+        "its channels are: x, y, vx",
+    ),
+    (
+        &["--channel", "x", "--integrator", "hht", "--steps", "10,,20"],
+        "empty",
+    ),
+    (
+        &["--channel", "x", "--integrator", "", "--steps", "10"],
+        "empty",
+    ),
+    (
+        &[
+            "--channel",
+            "x",
+            "--integrator",
+            "hht",
+            "--steps",
+            "10",
+            "--dt",
+            "0.1",
+        ],
+        "not both",
+    ),
+    (&["--channel", "x", "--integrator", "hht"], "--steps LIST"),
+    (
+        &["--channel", "x", "--integrator", "rk4", "--steps", "10"],
+        "unknown integrator `rk4`",
+    ),
+    (
+        &["--channel", "x", "--integrator", "hht:0.5", "--steps", "10"],
+        "outside [-1/3, 0]",
+    ),
+    (
+        &[
+            "--channel",
+            "x",
+            "--integrator",
+            "hht",
+            "--steps",
+            "10",
+            "--at",
+            "5",
+        ],
+        "outside the run",
+    ),
+    (
+        &[
+            "--channel",
+            "x",
+            "--integrator",
+            "hht",
+            "--alpha",
+            "0",
+            "--steps",
+            "10",
+        ],
+        "not both",
+    ),
+    (&["--channel", "x", "--steps", "10"], "--alpha LIST"),
+    (&["--channel", "x", "--alpha", "0.2"], "[-1/3, 0]"),
+    (
+        &["--channel", "x", "--alpha", "0", "--at", "0.5"],
+        "convergence studies",
+    ),
+    (
+        &["--channel", "x", "--integrator", "hht", "--dt", "5"],
+        "does not fit",
+    ),
+    (
+        &[
+            "--channel",
+            "x",
+            "--integrator",
+            "hht",
+            "--steps",
+            "10",
+            "--reference",
+            "nofile.csv",
+        ],
+        "cannot read reference file",
+    ),
+];
+
 #[test]
 fn bad_study_usage_exits_2_and_model_errors_exit_1() {
     let out = temp("study_bad.csv", "");
@@ -385,92 +473,7 @@ fn bad_study_usage_exits_2_and_model_errors_exit_1() {
         args.extend(extra.iter().map(|s| s.to_string()));
         args
     };
-    let cases: &[(&[&str], &str)] = &[
-        (
-            &["--channel", "xx", "--integrator", "hht", "--steps", "10"],
-            "its channels are: x, y, vx",
-        ),
-        (
-            &["--channel", "x", "--integrator", "hht", "--steps", "10,,20"],
-            "empty",
-        ),
-        (
-            &["--channel", "x", "--integrator", "", "--steps", "10"],
-            "empty",
-        ),
-        (
-            &[
-                "--channel",
-                "x",
-                "--integrator",
-                "hht",
-                "--steps",
-                "10",
-                "--dt",
-                "0.1",
-            ],
-            "not both",
-        ),
-        (&["--channel", "x", "--integrator", "hht"], "--steps LIST"),
-        (
-            &["--channel", "x", "--integrator", "rk4", "--steps", "10"],
-            "unknown integrator `rk4`",
-        ),
-        (
-            &["--channel", "x", "--integrator", "hht:0.5", "--steps", "10"],
-            "outside [-1/3, 0]",
-        ),
-        (
-            &[
-                "--channel",
-                "x",
-                "--integrator",
-                "hht",
-                "--steps",
-                "10",
-                "--at",
-                "5",
-            ],
-            "outside the run",
-        ),
-        (
-            &[
-                "--channel",
-                "x",
-                "--integrator",
-                "hht",
-                "--alpha",
-                "0",
-                "--steps",
-                "10",
-            ],
-            "not both",
-        ),
-        (&["--channel", "x", "--steps", "10"], "--alpha LIST"),
-        (&["--channel", "x", "--alpha", "0.2"], "[-1/3, 0]"),
-        (
-            &["--channel", "x", "--alpha", "0", "--at", "0.5"],
-            "convergence studies",
-        ),
-        (
-            &["--channel", "x", "--integrator", "hht", "--dt", "5"],
-            "does not fit",
-        ),
-        (
-            &[
-                "--channel",
-                "x",
-                "--integrator",
-                "hht",
-                "--steps",
-                "10",
-                "--reference",
-                "nofile.csv",
-            ],
-            "cannot read reference file",
-        ),
-    ];
-    for (extra, says) in cases {
+    for (extra, says) in BAD_USAGE {
         let o = mbd(&common(extra).iter().map(String::as_str).collect::<Vec<_>>());
         assert_eq!(code(&o), 2, "{extra:?}: {}", stderr(&o));
         assert!(stderr(&o).contains(says), "{extra:?}: {}", stderr(&o));
