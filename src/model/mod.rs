@@ -4,29 +4,20 @@
 //! dimensions and topology, and fixes the order of the unknowns (each multiplier after the
 //! unknowns it couples). Reports every error it finds. Must not know integrators or faer.
 
-mod angles;
-mod beams;
-mod bodies;
 mod build;
-mod center_of_mass;
-mod connect;
-pub mod dofs;
-mod elaborate;
-mod env;
+mod check;
 pub mod eval;
-mod exact;
-pub use exact::channel_dim;
-mod output_calls;
-mod outputs;
-mod resolve;
+mod scope;
 mod settings;
-pub mod topology;
-mod types;
-pub mod units;
 
-pub use build::{build, check_library};
+pub use build::{build, channel_dim, check_library};
+pub use check::{dofs, topology};
 pub use dofs::DofMap;
-pub use eval::Value;
+pub use eval::{units, Value};
+
+// The paths `settings.rs` names (`super::build::Builder`, `super::env::ScopeId`,
+// `super::units::Dim`).
+use scope::env;
 
 use crate::runtime::timefn::TimeFn;
 pub use crate::runtime::Coleman;

@@ -1,11 +1,11 @@
 //! Bodies, beams, sections and markers.
 
-use super::build::{add, dot, norm, scale, sub, Builder, Built, View};
-use super::env::{Ref, Seg};
-use super::eval::{mat_mul, mat_vec, transpose, Value};
-use super::units::Dim;
-use super::*;
+use super::{add, dot, norm, scale, sub, Builder, Built, View};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::model::eval::units::Dim;
+use crate::model::eval::{mat_mul, mat_vec, transpose, Value};
+use crate::model::scope::env::{Ref, Seg};
+use crate::model::*;
 use crate::syntax::ast::{Block, MarkerRef};
 
 const INERTIA: Dim = Dim::new(1, 2, 0);

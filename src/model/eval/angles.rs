@@ -8,10 +8,10 @@
 //! counts), no `pi`, no inverse trigonometric function, also through the params, lets,
 //! functions and arguments it names.
 
-use super::env::{BindingKind, Env, Named, ScopeId};
-use super::types::ParamType;
 use super::units;
 use crate::diagnostics::{Code, Diagnostic};
+use crate::model::scope::env::{BindingKind, Env, Named, ScopeId};
+use crate::model::scope::types::ParamType;
 use crate::syntax::ast::{Expr, ExprKind, UnitExpr};
 
 /// Units that make a number an angle.

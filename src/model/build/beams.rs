@@ -1,11 +1,11 @@
 //! Beams and their sections; `beam NAME rigid` lowers to one rigid body.
 
-use super::build::{add, cross, dot, norm, scale, sub, Builder, Built, View};
-use super::env::Ref;
-use super::eval::{mat_mul, rotation, Value};
-use super::units::{self, Dim, Quantity};
-use super::*;
+use super::{add, cross, dot, norm, scale, sub, Builder, Built, View};
 use crate::diagnostics::{Code, Diagnostic};
+use crate::model::eval::units::{self, Dim, Quantity};
+use crate::model::eval::{mat_mul, rotation, Value};
+use crate::model::scope::env::Ref;
+use crate::model::*;
 use crate::syntax::ast::{Block, PropValue};
 
 const BENDING: Quantity = Dim::new(1, 3, -2).quantity();

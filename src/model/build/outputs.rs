@@ -1,9 +1,9 @@
 //! Output channels: `output x = bob.position.x, tension = link.force, rotor.lag[1].angle`.
 
-use super::build::{Builder, Built};
-use super::env::{Ref, ScopeId, Seg};
-use super::*;
+use super::{Builder, Built};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::model::scope::env::{Ref, ScopeId, Seg};
+use crate::model::*;
 use crate::syntax::ast::{ExprKind, MarkerRef, OutputItem, OutputTarget, Path, Segment};
 use std::collections::HashMap;
 
@@ -195,7 +195,7 @@ impl Builder<'_> {
             segs.iter()
                 .map(|s| match (s.index, &s.arg) {
                     (Some((i, _)), _) => format!("{}[{i}]", s.name.name),
-                    (None, Some((super::eval::Value::Scalar { value, .. }, _))) => {
+                    (None, Some((crate::model::eval::Value::Scalar { value, .. }, _))) => {
                         format!("{}({value})", s.name.name)
                     }
                     _ => s.name.name.clone(),

@@ -2,12 +2,22 @@
 //! beams, joints, springs and loads, then check the topology and number the unknowns.
 //! Every error found is reported; the model is returned only if there are none.
 
-use super::elaborate::{unused_bindings, Elaborator};
-use super::env::{is_secondary, BindingKind, Env, Named, ScopeId};
-use super::eval::Value;
-use super::units::{Dim, Quantity};
-use super::*;
+mod beams;
+mod bodies;
+mod center_of_mass;
+mod connect;
+mod exact;
+mod output_calls;
+mod outputs;
+
+pub use exact::channel_dim;
+
 use crate::diagnostics::{did_you_mean, merge_repeats, Code, Diagnostic, Sink};
+use crate::model::eval::units::{Dim, Quantity};
+use crate::model::eval::Value;
+use crate::model::scope::elaborate::{unused_bindings, Elaborator};
+use crate::model::scope::env::{is_secondary, BindingKind, Env, Named, ScopeId};
+use crate::model::*;
 use crate::source::SourceMap;
 use crate::syntax::ast::{self, Block, Expr, Item, MarkerRef, Prop, PropValue};
 use std::collections::HashMap;
@@ -731,7 +741,11 @@ impl Builder<'_> {
     }
 
     /// Warnings for what the model file declares and never uses.
-    fn unused(&mut self, main: crate::source::SourceId, out: &super::elaborate::Elaborated) {
+    fn unused(
+        &mut self,
+        main: crate::source::SourceId,
+        out: &crate::model::scope::elaborate::Elaborated,
+    ) {
         let mut warnings = Vec::new();
         for b in unused_bindings(&self.env) {
             if b.span.source != main {

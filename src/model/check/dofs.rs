@@ -6,7 +6,7 @@
 //! last node it couples, so eliminating a multiplier meets a non-zero pivot (THEORY §6) and the
 //! factorization needs no pivoting.
 
-use super::{Attach, BodyKind, Model};
+use crate::model::{Attach, BodyKind, Model};
 use serde::Serialize;
 use std::collections::VecDeque;
 

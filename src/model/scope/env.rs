@@ -10,10 +10,10 @@
 //! scope of its own for the loop variable and its lets, but declares its bodies in the
 //! enclosing naming scope (its `home`), so `blade[i]` is visible after the loop.
 
-use super::eval::{eval, Names, Value};
 use super::types::ParamType;
-use super::units::Dim;
 use crate::diagnostics::{Code, Diagnostic, Iteration};
+use crate::model::eval::units::Dim;
+use crate::model::eval::{eval, Names, Value};
 use crate::runtime::timefn::TimeFn;
 use crate::source::Span;
 use crate::syntax::ast::{Component, Expr, ExprKind, Ident, Item, Path, PropValue};
@@ -544,7 +544,7 @@ impl Env {
                     .hint(ty.example()));
             }
             if let (ParamType::Scalar(q), Value::Scalar { value, .. }) = (ty, &v) {
-                if q == super::units::ANGLE {
+                if q == crate::model::eval::units::ANGLE {
                     let what = format!(
                         "argument `{}` of `{}`",
                         b.name,

@@ -7,8 +7,8 @@
 
 use super::env::{Binding, BindingKind, Decl, Env, Named, ScopeId};
 use super::types::ParamType;
-use super::{LoadRequest, Loader};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic, Iteration};
+use crate::model::{LoadRequest, Loader};
 use crate::source::{SourceMap, Span};
 use crate::syntax::ast::{Component, Ident, Item, OutputItem, UseTarget};
 use std::collections::{HashMap, HashSet};
@@ -163,7 +163,7 @@ impl<'a> Elaborator<'a> {
     /// Marks the names an untaken `if` branch mentions as used, so a param used only there is
     /// not reported unused.
     fn mention(&mut self, items: &[Item], scope: ScopeId) {
-        for name in items.iter().flat_map(super::build::written_names) {
+        for name in items.iter().flat_map(crate::model::build::written_names) {
             if let Some(Named::Binding(id)) = self.env.lookup(scope, &name) {
                 self.env.bindings[id].used = true;
             }
@@ -443,7 +443,10 @@ impl<'a> Elaborator<'a> {
                         value: i,
                         count: end - a,
                     });
-                    let v = super::eval::Value::scalar(i as f64, super::units::Dim::NONE);
+                    let v = crate::model::eval::Value::scalar(
+                        i as f64,
+                        crate::model::eval::units::Dim::NONE,
+                    );
                     let mut b = Env::binding(
                         var,
                         var.span,
@@ -471,7 +474,7 @@ impl<'a> Elaborator<'a> {
                     return self.misplaced(scope, *span, "if", at);
                 }
                 let c = match self.env.eval_in(scope, cond) {
-                    Ok(super::eval::Value::Scalar { value, dim }) if dim.is_none() => value != 0.0,
+                    Ok(crate::model::eval::Value::Scalar { value, dim }) if dim.is_none() => value != 0.0,
                     Ok(v) => {
                         return self.error(
                             scope,

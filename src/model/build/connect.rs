@@ -1,10 +1,10 @@
 //! Joints, springs and dampers, loads, and initial motion.
 
-use super::build::{add, cross, dot, norm, scale, sub, Builder, Built, View};
-use super::env::{Member, Ref};
-use super::units::{self, Dim, Quantity};
-use super::*;
+use super::{add, cross, dot, norm, scale, sub, Builder, Built, View};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::model::eval::units::{self, Dim, Quantity};
+use crate::model::scope::env::{Member, Ref};
+use crate::model::*;
 use crate::syntax::ast::{Item, MarkerRef};
 
 const RATE: Dim = Dim::new(0, 0, -1);

@@ -9,10 +9,10 @@
 //! The Jacobian is taken with respect to virtual displacements and rotations of every node,
 //! which has the rank of the Jacobian in any rotation parameters.
 
-use super::build::{cross, dot, norm, sub};
 use super::dofs::{attach_nodes, Node};
-use super::*;
 use crate::diagnostics::{Code, Diagnostic, Sink};
+use crate::model::build::{cross, dot, norm, sub};
+use crate::model::*;
 use nalgebra::{DMatrix, SymmetricEigen};
 
 /// Columns of a node in the virtual-motion vector.
@@ -403,7 +403,7 @@ fn massless(model: &Model, r: &mut Rows, sink: &mut Sink) {
     for (body, b) in model.bodies.iter().enumerate() {
         let s = cols.start[cols.of(Node::Body { body })];
         let sm = b.mass.sqrt();
-        let c = super::eval::mat_vec(b.orientation, b.center);
+        let c = crate::model::eval::mat_vec(b.orientation, b.center);
         for i in 0..3 {
             // sqrt(m) (du + dtheta x c)_i
             let mut row = vec![0.0; n];
@@ -418,9 +418,9 @@ fn massless(model: &Model, r: &mut Rows, sink: &mut Sink) {
             r.rows.push(row);
         }
         if b.kind == BodyKind::Rigid {
-            let rot = super::eval::mat_mul(
-                super::eval::mat_mul(b.orientation, b.inertia),
-                super::eval::transpose(b.orientation),
+            let rot = crate::model::eval::mat_mul(
+                crate::model::eval::mat_mul(b.orientation, b.inertia),
+                crate::model::eval::transpose(b.orientation),
             );
             let eig = SymmetricEigen::new(nalgebra::Matrix3::from_fn(|i, k| rot[i][k]));
             for q in 0..3 {

@@ -3,12 +3,12 @@
 //! masses it carries. The runtime weighs each mass centre as its element's inertial forces do
 //! (a rigid body's `x + R eta`, a beam's section mass at the inertial quadrature points).
 
-use super::build::{Builder, Built};
-use super::env::{Member, Ref, ScopeId, Seg};
 use super::output_calls::segment;
 use super::outputs::AXES;
-use super::*;
+use super::{Builder, Built};
 use crate::diagnostics::{Code, Diagnostic};
+use crate::model::scope::env::{Member, Ref, ScopeId, Seg};
+use crate::model::*;
 use crate::syntax::ast::{OutputArg, OutputCall};
 
 /// What may follow `center_of_mass(...)`.

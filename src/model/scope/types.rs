@@ -1,7 +1,7 @@
 //! The types of component parameters: `blades: int`, `hinge_offset: length`, `hub: marker`.
 
-use super::eval::Value;
-use super::units::{self, Dim, Quantity};
+use crate::model::eval::units::{self, Dim, Quantity};
+use crate::model::eval::Value;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamType {
