@@ -4,7 +4,7 @@
 //! (a rigid body's `x + R eta`, a beam's section mass at the inertial quadrature points).
 
 use super::output_calls::segment;
-use super::outputs::AXES;
+use super::probes::AXES;
 use super::{Builder, Built};
 use crate::diagnostics::{Code, Diagnostic};
 use crate::model::scope::env::{Member, Ref, ScopeId, Seg};

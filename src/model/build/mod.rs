@@ -7,20 +7,28 @@ mod bodies;
 mod center_of_mass;
 mod connect;
 mod exact;
+mod initial;
+mod joints;
+mod markers;
 mod output_calls;
 mod outputs;
+mod probes;
+mod sections;
+mod unused;
+mod values;
 
 pub use exact::channel_dim;
+pub(super) use unused::written_names;
+use values::unit_hint;
 
 use crate::diagnostics::{did_you_mean, merge_repeats, Code, Diagnostic, Sink};
-use crate::model::eval::units::{Dim, Quantity};
+use crate::model::eval::units::Dim;
 use crate::model::eval::Value;
-use crate::model::scope::elaborate::{unused_bindings, Elaborator};
+use crate::model::scope::elaborate::{Elaborated, Elaborator};
 use crate::model::scope::env::{is_secondary, BindingKind, Env, Named, ScopeId};
 use crate::model::*;
 use crate::source::SourceMap;
-use crate::syntax::ast::{self, Block, Expr, Item, MarkerRef, Prop, PropValue};
-use std::collections::HashMap;
+use crate::syntax::ast::{self, Block, Expr, Item, MarkerRef};
 
 /// What a declaration became.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -121,107 +129,36 @@ fn build_model(
     for e in errors {
         sink.push(e);
     }
-    if out.header.is_none() {
-        sink.push(
-            Diagnostic::error(Code::E0103, "the file has no `model` header")
-                .at(
-                    Span {
-                        end: file.span.start,
-                        ..file.span
-                    },
-                    "expected `model NAME \"title\"` here",
-                )
-                .hint("begin the file with `model NAME \"what it is\"`"),
-        );
-    }
-    let mut b = Builder {
-        built: vec![None; env.decls.len()],
-        env,
-        sink,
-        grounds: Vec::new(),
-        bodies: Vec::new(),
-        beams: Vec::new(),
-        sections: Vec::new(),
-        joints: Vec::new(),
-        springs: Vec::new(),
-        loads: Vec::new(),
-        body_decl: Vec::new(),
-        beam_decl: Vec::new(),
-    };
-
-    // Params, in the order written.
-    let mut params = Vec::new();
-    let mut ids: Vec<usize> = (0..b.env.bindings.len())
-        .filter(|&i| b.env.bindings[i].kind == BindingKind::Param && b.env.bindings[i].scope == top)
-        .collect();
-    ids.sort_by_key(|&i| b.env.bindings[i].span.start);
-    for id in ids {
-        let used = b.env.bindings[id].used;
-        let span = b.env.bindings[id].span;
-        if let Ok(v) = b.env.value_of(id, span) {
-            params.push((b.env.bindings[id].name.clone(), v));
+    // Where the header is, or belongs.
+    let header = match &out.header {
+        Some((_, _, span)) => *span,
+        None => {
+            let at = Span {
+                end: file.span.start,
+                ..file.span
+            };
+            sink.push(
+                Diagnostic::error(Code::E0103, "the file has no `model` header")
+                    .at(at, "expected `model NAME \"title\"` here")
+                    .hint("begin the file with `model NAME \"what it is\"`"),
+            );
+            at
         }
-        b.env.bindings[id].used = used;
-    }
+    };
+    let mut b = Builder::new(env, sink);
+    let params = b.params(top);
     let gravity = match &out.gravity {
         Some((g, _)) => b
             .vector(top, g, Dim::ACCELERATION, "gravity")
             .unwrap_or([0.0; 3]),
         None => [0.0; 3],
     };
-
-    // Declarations: sections, then bodies and beams, then what attaches to them.
-    let views: Vec<Option<View>> = (0..b.env.decls.len()).map(|d| b.view(d)).collect();
-    let order = |v: &View| match v.kind.name.as_str() {
-        "section" => 0,
-        "ground" | "point_mass" | "rigid" | "rigid_rod" | "beam" => 1,
-        "concentrated_mass" => 2,
-        _ => 3,
-    };
-    for pass in 0..4 {
-        for v in views.iter().flatten() {
-            if order(v) == pass {
-                b.entity(v);
-            }
-        }
-    }
-    // Joints come after everything they can attach to.
-    for d in 0..b.env.decls.len() {
-        if let Item::Joint { .. } = &*b.env.decls[d].item {
-            b.joint(d);
-        }
-    }
-    for (item, scope) in &out.initials {
-        b.initial(item, *scope);
-    }
+    b.declarations(&out);
     let outputs = b.outputs(&out.outputs);
     let exact = b.exacts(&out.exacts, &outputs);
     // A missing solve block is reported at the header (or where it belongs).
-    let header = match &out.header {
-        Some((_, _, span)) => *span,
-        None => Span {
-            end: file.span.start,
-            ..file.span
-        },
-    };
     let solve = b.solve(out.solve.as_ref(), overrides, top, file.span, header);
-
-    for e in std::mem::take(&mut b.env.errors) {
-        b.sink.push(e);
-    }
-    if b.bodies.is_empty() && b.beams.is_empty() && b.sink.diagnostics.iter().all(|d| !d.is_error())
-    {
-        b.sink.push(
-            Diagnostic::error(Code::E0304, "the model has no bodies")
-                .at(file.items[0].span(), "in this model")
-                .hint("declare a body, e.g. `point_mass bob { mass = 1 kg, at = (0, -1, 0) m }`"),
-        );
-    }
-    for e in std::mem::take(&mut b.env.errors) {
-        b.sink.push(e);
-    }
-    b.excuse_failed(&file.items, file.span.source);
-    b.unused(file.span.source, &out);
+    b.finish(file, &out);
     if b.sink.has_errors() {
         return None;
     }
@@ -286,7 +223,96 @@ pub fn check_library(
     out.into_iter().map(|x| x.1).collect()
 }
 
-impl Builder<'_> {
+impl<'s> Builder<'s> {
+    fn new(env: Env, sink: &'s mut Sink) -> Builder<'s> {
+        Builder {
+            built: vec![None; env.decls.len()],
+            env,
+            sink,
+            grounds: Vec::new(),
+            bodies: Vec::new(),
+            beams: Vec::new(),
+            sections: Vec::new(),
+            joints: Vec::new(),
+            springs: Vec::new(),
+            loads: Vec::new(),
+            body_decl: Vec::new(),
+            beam_decl: Vec::new(),
+        }
+    }
+
+    /// The top-level params' values, in the order written (evaluating them marks nothing
+    /// used).
+    fn params(&mut self, top: ScopeId) -> Vec<(String, Value)> {
+        let env = &mut self.env;
+        let mut params = Vec::new();
+        let mut ids: Vec<usize> = (0..env.bindings.len())
+            .filter(|&i| env.bindings[i].kind == BindingKind::Param && env.bindings[i].scope == top)
+            .collect();
+        ids.sort_by_key(|&i| env.bindings[i].span.start);
+        for id in ids {
+            let used = env.bindings[id].used;
+            let span = env.bindings[id].span;
+            if let Ok(v) = env.value_of(id, span) {
+                params.push((env.bindings[id].name.clone(), v));
+            }
+            env.bindings[id].used = used;
+        }
+        params
+    }
+
+    /// Builds the declarations: sections, then bodies and beams, then what attaches to them;
+    /// joints after everything they can attach to; then the initial motions.
+    fn declarations(&mut self, out: &Elaborated) {
+        let views: Vec<Option<View>> = (0..self.env.decls.len()).map(|d| self.view(d)).collect();
+        let order = |v: &View| match v.kind.name.as_str() {
+            "section" => 0,
+            "ground" | "point_mass" | "rigid" | "rigid_rod" | "beam" => 1,
+            "concentrated_mass" => 2,
+            _ => 3,
+        };
+        for pass in 0..4 {
+            for v in views.iter().flatten() {
+                if order(v) == pass {
+                    self.entity(v);
+                }
+            }
+        }
+        for d in 0..self.env.decls.len() {
+            if let Item::Joint { .. } = &*self.env.decls[d].item {
+                self.joint(d);
+            }
+        }
+        for (item, scope) in &out.initials {
+            self.initial(item, *scope);
+        }
+    }
+
+    /// The errors evaluation left in the scopes, a model with no bodies (E0304), and the
+    /// warnings for what is never used.
+    fn finish(&mut self, file: &ast::File, out: &Elaborated) {
+        for e in std::mem::take(&mut self.env.errors) {
+            self.sink.push(e);
+        }
+        if self.bodies.is_empty()
+            && self.beams.is_empty()
+            && self.sink.diagnostics.iter().all(|d| !d.is_error())
+        {
+            self.sink.push(
+                Diagnostic::error(Code::E0304, "the model has no bodies")
+                    .at(file.items[0].span(), "in this model")
+                    .hint(
+                        "declare a body, e.g. `point_mass bob { mass = 1 kg, at = (0, -1, 0) m }`",
+                    ),
+            );
+        }
+        for e in std::mem::take(&mut self.env.errors) {
+            self.sink.push(e);
+        }
+        self.excuse_failed(&file.items, file.span.source);
+        self.unused(file.span.source, out);
+    }
+
     fn view(&self, d: usize) -> Option<View> {
         let decl = &self.env.decls[d];
         match &*decl.item {
@@ -367,509 +393,6 @@ impl Builder<'_> {
                 && (decl.name == name || decl.name.starts_with(&format!("{name}.")))
         })
     }
-
-    /// Checks the parts a declaration has against those its kind takes.
-    pub fn shape(
-        &mut self,
-        v: &View,
-        markers: usize,
-        on: bool,
-        value: bool,
-        flags: &[&str],
-        example: &str,
-    ) -> bool {
-        let mut ok = true;
-        let kind = v.kind.name.clone();
-        let mut bad = |this: &mut Self, span: Span, what: String| {
-            ok = false;
-            this.error(
-                v.scope,
-                Diagnostic::error(Code::E0224, format!("`{kind}` {what}"))
-                    .at(span, "here")
-                    .hint(format!("write it as `{example}`")),
-            );
-        };
-        if v.markers.len() != markers {
-            let span = v.markers.first().map(|m| m.span).unwrap_or(v.name_span);
-            let what = match markers {
-                0 => "does not connect markers".to_string(),
-                n => format!("connects {n} markers, found {}", v.markers.len()),
-            };
-            bad(self, span, what);
-        }
-        match (&v.on, on) {
-            (Some(m), false) => bad(self, m.span, "takes no `on` marker".to_string()),
-            (None, true) => bad(self, v.name_span, "needs `on MARKER`".to_string()),
-            _ => {}
-        }
-        match (&v.value, value) {
-            (Some(e), false) => bad(self, e.span, "takes no `= value`".to_string()),
-            (None, true) => bad(self, v.name_span, "needs `= value`".to_string()),
-            _ => {}
-        }
-        for f in &v.flags {
-            if !flags.contains(&f.name.as_str()) {
-                bad(self, f.span, format!("takes no flag `{}`", f.name));
-            }
-        }
-        ok
-    }
-
-    pub fn has_flag(v: &View, flag: &str) -> bool {
-        v.flags.iter().any(|f| f.name == flag)
-    }
-
-    /// Splits a block by property name, reporting unknown and repeated properties.
-    pub fn props(
-        &mut self,
-        scope: ScopeId,
-        block: Option<&Block>,
-        known: &[&'static str],
-        of: &str,
-    ) -> HashMap<&'static str, Prop> {
-        let mut out: HashMap<&'static str, Prop> = HashMap::new();
-        let Some(block) = block else {
-            return out;
-        };
-        for p in &block.props {
-            match known.iter().find(|k| **k == p.name.name) {
-                Some(&k) => {
-                    if let Some(first) = out.get(k) {
-                        let d =
-                            Diagnostic::error(Code::E0203, format!("property `{k}` is set twice"))
-                                .at(p.name.span, "second value")
-                                .at(first.name.span, "first value")
-                                .hint("set each property once");
-                        self.error(scope, d);
-                    } else {
-                        out.insert(k, p.clone());
-                    }
-                }
-                None => {
-                    let hint = match did_you_mean(&p.name.name, known.iter().copied()) {
-                        Some(s) => format!("did you mean `{s}`? {of} takes: {}", known.join(", ")),
-                        None => format!("{of} takes: {}", known.join(", ")),
-                    };
-                    let d = Diagnostic::error(
-                        Code::E0205,
-                        format!("{of} has no property `{}`", p.name.name),
-                    )
-                    .at(p.name.span, "unknown property")
-                    .hint(hint);
-                    self.error(scope, d);
-                }
-            }
-        }
-        out
-    }
-
-    /// A property's expression; a `{ ... }` block where a value belongs is an error.
-    pub fn expr<'p>(&mut self, scope: ScopeId, p: Option<&'p Prop>) -> Option<&'p Expr> {
-        let p = p?;
-        match &p.value {
-            PropValue::Expr(e) => Some(e),
-            PropValue::Block(b) => {
-                self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0209,
-                        format!("`{}` takes a value, not a block", p.name.name),
-                    )
-                    .at(b.span, "a block")
-                    .hint(format!("write `{} = value`", p.name.name)),
-                );
-                None
-            }
-        }
-    }
-
-    /// A required property's expression; reports it missing (E0206) when it is not written.
-    pub fn required<'p>(
-        &mut self,
-        scope: ScopeId,
-        p: &'p HashMap<&'static str, Prop>,
-        key: &str,
-        at: Span,
-        of: &str,
-        example: &str,
-    ) -> Option<&'p Expr> {
-        match p.get(key) {
-            Some(prop) => self.expr(scope, Some(prop)),
-            None => {
-                self.missing(scope, at, key, of, example);
-                None
-            }
-        }
-    }
-
-    pub fn missing(&mut self, scope: ScopeId, at: Span, prop: &str, of: &str, example: &str) {
-        self.error(
-            scope,
-            Diagnostic::error(Code::E0206, format!("{of} needs `{prop}`"))
-                .at(at, format!("`{prop}` missing"))
-                .hint(format!("add `{prop} = {example}`")),
-        );
-    }
-
-    pub fn value(&mut self, scope: ScopeId, e: &Expr) -> Option<Value> {
-        match self.env.eval_in(scope, e) {
-            Ok(v) => Some(v),
-            Err(d) => {
-                self.error(scope, d);
-                None
-            }
-        }
-    }
-
-    /// Evaluates `e` as a constant of the given shape and dimension.
-    fn typed(
-        &mut self,
-        scope: ScopeId,
-        e: &Expr,
-        want: Quantity,
-        what: &str,
-        vector: bool,
-    ) -> Option<Value> {
-        let v = self.value(scope, e)?;
-        let error = match (&v, vector) {
-            (Value::Signal { .. }, _) => Diagnostic::error(
-                Code::E0401,
-                format!("{what} must be a constant, found a function of time"),
-            )
-            .at(e.span, "this varies in time"),
-            (Value::Scalar { .. }, true)
-            | (Value::Vector { .. }, false)
-            | (Value::Rotation { .. }, _) => {
-                let shape = if vector {
-                    "a vector `(x, y, z)`"
-                } else {
-                    "a scalar"
-                };
-                Diagnostic::error(
-                    Code::E0209,
-                    format!("{what} must be {shape}, found {}", v.kind_name()),
-                )
-                .at(e.span, format!("this is {}", v.kind_name()))
-            }
-            _ if v.dim() != want.dim => self.mismatch(scope, e, want, v.dim(), what),
-            _ => return Some(v),
-        };
-        let hint = if let Value::Signal { .. } = v {
-            "only loads, prescribed motions and functions may depend on `t`".to_string()
-        } else if vector && !matches!(v, Value::Vector { .. }) {
-            format!("write `(x, y, z)`; {}", unit_hint(want, vector))
-        } else {
-            unit_hint(want, vector)
-        };
-        self.error(scope, error.hint(hint));
-        None
-    }
-
-    /// E0202 for `e`, found of dimension `found` where `want` is needed: at the use, and at
-    /// the definition of the param or let it names.
-    fn mismatch(
-        &self,
-        scope: ScopeId,
-        e: &Expr,
-        want: Quantity,
-        found: Dim,
-        what: &str,
-    ) -> Diagnostic {
-        let found = found.describe();
-        let d = Diagnostic::error(
-            Code::E0202,
-            format!("{what} must be {}, found {found}", want.describe()),
-        )
-        .at(e.span, format!("this is {found}"));
-        match self.env.definition(scope, e) {
-            Some((span, how)) => d.at(span, format!("{how} as {found}")),
-            None => d,
-        }
-    }
-
-    pub fn scalar(
-        &mut self,
-        scope: ScopeId,
-        e: &Expr,
-        want: impl Into<Quantity>,
-        what: &str,
-    ) -> Option<f64> {
-        match self.typed(scope, e, want.into(), what, false)? {
-            Value::Scalar { value, .. } => Some(value),
-            _ => None,
-        }
-    }
-
-    pub fn vector(
-        &mut self,
-        scope: ScopeId,
-        e: &Expr,
-        want: impl Into<Quantity>,
-        what: &str,
-    ) -> Option<[f64; 3]> {
-        match self.typed(scope, e, want.into(), what, true)? {
-            Value::Vector { value, .. } => Some(value),
-            _ => None,
-        }
-    }
-
-    /// A non-zero direction, normalised. Any dimension is accepted (`(1, 0, 0)`, `(0, 0, 1) m`).
-    pub fn direction(&mut self, scope: ScopeId, e: &Expr, what: &str) -> Option<[f64; 3]> {
-        let v = self.value(scope, e)?;
-        let Value::Vector { value, .. } = v else {
-            self.error(
-                scope,
-                Diagnostic::error(
-                    Code::E0209,
-                    format!(
-                        "{what} must be a constant direction, found {}",
-                        v.kind_name()
-                    ),
-                )
-                .at(e.span, format!("this is {}", v.kind_name()))
-                .hint("write an axis such as `z` or `(0, 0, 1)`"),
-            );
-            return None;
-        };
-        let n = norm(value);
-        if n == 0.0 {
-            self.error(
-                scope,
-                Diagnostic::error(Code::E0303, format!("{what} is a zero vector"))
-                    .at(e.span, "has no direction")
-                    .hint("give a non-zero axis such as `z` or `(0, 0, 1)`"),
-            );
-            return None;
-        }
-        Some(value.map(|x| x / n))
-    }
-
-    /// A time function (a constant is a constant function) with the given dimension.
-    pub fn signal(
-        &mut self,
-        scope: ScopeId,
-        e: &Expr,
-        want: impl Into<Quantity>,
-        what: &str,
-        vector: bool,
-    ) -> Option<Vec<TimeFn>> {
-        let want = want.into();
-        let v = self.value(scope, e)?;
-        let parts = v.parts();
-        let count = if vector { 3 } else { 1 };
-        match parts {
-            Some((p, d)) if p.len() == count && d == want.dim => Some(p),
-            Some((p, d)) if p.len() == count => {
-                let error = self.mismatch(scope, e, want, d, what);
-                self.error(scope, error.hint(unit_hint(want, vector)));
-                None
-            }
-            _ => {
-                let shape = if vector {
-                    "a vector (x, y, z)"
-                } else {
-                    "a scalar"
-                };
-                self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0209,
-                        format!("{what} must be {shape}, found {}", v.kind_name()),
-                    )
-                    .at(e.span, format!("this is {}", v.kind_name()))
-                    .hint(unit_hint(want, vector)),
-                );
-                None
-            }
-        }
-    }
-
-    pub fn rotation(&mut self, scope: ScopeId, e: &Expr, what: &str) -> Option<Mat3> {
-        match self.value(scope, e)? {
-            Value::Rotation { matrix } => Some(matrix),
-            v => {
-                self.error(
-                    scope,
-                    Diagnostic::error(Code::E0209, format!("{what} must be a rotation, found {}", v.kind_name()))
-                        .at(e.span, format!("this is {}", v.kind_name()))
-                        .hint("write `rotate(axis, angle)`, e.g. `rotate(z, 90 deg)`, or a product of rotations"),
-                );
-                None
-            }
-        }
-    }
-
-    pub fn integer(&mut self, scope: ScopeId, e: &Expr, what: &str, min: usize) -> Option<usize> {
-        let x = self.scalar(scope, e, Dim::NONE, what)?;
-        if x.fract() != 0.0 || x < min as f64 || x > 1e9 {
-            self.error(
-                scope,
-                Diagnostic::error(
-                    Code::E0213,
-                    format!("{what} must be a whole number of at least {min}"),
-                )
-                .at(e.span, "not allowed here")
-                .hint(format!("write an integer such as {}", min.max(1))),
-            );
-            return None;
-        }
-        Some(x as usize)
-    }
-
-    /// Marks as used every name written in a declaration of the model file that failed (the
-    /// innermost item holding a label of an error): a param whose only user failed was not
-    /// forgotten, and "never used" would be a second report of one mistake.
-    fn excuse_failed(&mut self, items: &[Item], main: crate::source::SourceId) {
-        let spans: Vec<Span> = self
-            .sink
-            .diagnostics
-            .iter()
-            .filter(|d| d.is_error())
-            .flat_map(|d| d.labels.iter().map(|l| l.span))
-            .filter(|s| s.source == main)
-            .collect();
-        if spans.is_empty() {
-            return;
-        }
-        let mut names = std::collections::HashSet::new();
-        failed_names(items, &spans, &mut names);
-        for b in &mut self.env.bindings {
-            if b.span.source == main && names.contains(&b.name) {
-                b.used = true;
-            }
-        }
-    }
-
-    /// Warnings for what the model file declares and never uses.
-    fn unused(
-        &mut self,
-        main: crate::source::SourceId,
-        out: &crate::model::scope::elaborate::Elaborated,
-    ) {
-        let mut warnings = Vec::new();
-        for b in unused_bindings(&self.env) {
-            if b.span.source != main {
-                continue;
-            }
-            let (code, what, hint) = match b.kind {
-                BindingKind::Param => (
-                    Code::W0201,
-                    "param",
-                    "remove it, or use it in a property or an output",
-                ),
-                BindingKind::Let => (Code::W0202, "let", "remove it, or use it"),
-                BindingKind::Function => (
-                    Code::W0202,
-                    "function",
-                    "remove it, or use it in a load or a prescribed motion",
-                ),
-                _ => continue,
-            };
-            warnings.push(
-                Diagnostic::error(code, format!("{what} `{}` is never used", b.name))
-                    .at(b.span, "declared here")
-                    .hint(hint),
-            );
-        }
-        for (d, decl) in self.env.decls.iter().enumerate() {
-            if decl.used || decl.name_span.source != main {
-                continue;
-            }
-            if let Some(Built::Section(_)) = self.built[d] {
-                warnings.push(
-                    Diagnostic::error(
-                        Code::W0202,
-                        format!("section `{}` is never used", decl.name),
-                    )
-                    .at(decl.name_span, "declared here")
-                    .hint("remove it, or give it to a beam: `section = NAME`"),
-                );
-            }
-        }
-        for (name, span) in &out.local_components {
-            let defined = self.env.scopes.iter().any(|s| {
-                s.names.get(name).map(|n| matches!(n, Named::Component(c, _) if c.name.span == *span && out.instantiated.contains(&c.span))).unwrap_or(false)
-            });
-            if !defined {
-                warnings.push(
-                    Diagnostic::error(
-                        Code::W0202,
-                        format!("component `{name}` is never instantiated"),
-                    )
-                    .at(*span, "declared here")
-                    .hint(format!(
-                        "remove it, or instantiate it: `NAME = {name}(...)`"
-                    )),
-                );
-            }
-        }
-        warnings.sort_by_key(|d| d.labels.first().map(|l| l.span.start));
-        for w in warnings {
-            self.sink.push(w);
-        }
-    }
-}
-
-/// Collects the names written in the innermost items that contain one of `spans`; whether
-/// any item did.
-fn failed_names(
-    items: &[Item],
-    spans: &[Span],
-    names: &mut std::collections::HashSet<String>,
-) -> bool {
-    let mut any = false;
-    for item in items {
-        let outer = item.span();
-        if !spans
-            .iter()
-            .any(|s| outer.start <= s.start && s.end <= outer.end)
-        {
-            continue;
-        }
-        any = true;
-        let inside = match item {
-            Item::For { items, .. } => failed_names(items, spans, names),
-            Item::If {
-                then, otherwise, ..
-            } => failed_names(then, spans, names) | failed_names(otherwise, spans, names),
-            Item::Component(c) => failed_names(&c.items, spans, names),
-            _ => false,
-        };
-        if !inside {
-            names.extend(written_names(item));
-        }
-    }
-    any
-}
-
-/// Every name an item writes (declared or used), read from its syntax tree.
-pub(super) fn written_names(item: &Item) -> Vec<String> {
-    let Ok(text) = serde_json::to_string(item) else {
-        return Vec::new();
-    };
-    text.split("\"name\":\"")
-        .skip(1)
-        .filter_map(|part| part.split('"').next())
-        .map(str::to_string)
-        .collect()
-}
-
-/// "expected a length [m], e.g. `0.5 m`" (a vector of it: "`(0, 0, 0.5) m`").
-pub(super) fn unit_hint(want: Quantity, vector: bool) -> String {
-    let example = match (vector, want.dim.is_none()) {
-        (false, _) => want.example(),
-        (true, true) => "`(1, 0, 0)`".to_string(),
-        (true, false) => {
-            let e = want.example();
-            // `0.5 m` -> `(0, 0, 0.5) m`
-            let inner = e.trim_matches('`');
-            match inner.split_once(' ') {
-                Some((x, unit)) => format!("`(0, 0, {x}) {unit}`"),
-                None => format!("`(0, 0, {inner})`"),
-            }
-        }
-    };
-    format!("expected {}, e.g. {example}", want.describe())
 }
 
 pub(super) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {

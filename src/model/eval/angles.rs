@@ -120,7 +120,7 @@ impl Env {
             _ => "give the angle a unit: multiply by `1 deg` for degrees, or by `1 rad` to say it is radians".to_string(),
         };
         Some(
-            Diagnostic::error(Code::W0203, format!("{what} has no angle unit{read}"))
+            Diagnostic::warning(Code::W0203, format!("{what} has no angle unit{read}"))
                 .at(e.span, "no `rad`, `deg` or `rev`")
                 .hint(hint),
         )

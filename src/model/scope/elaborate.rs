@@ -10,9 +10,12 @@ use super::types::ParamType;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic, Iteration};
 use crate::model::{LoadRequest, Loader};
 use crate::source::{SourceMap, Span};
-use crate::syntax::ast::{Component, Ident, Item, OutputItem, UseTarget};
+use crate::syntax::ast::{Component, Expr, Ident, Item, Name, OutputItem, UseTarget};
 use std::collections::{HashMap, HashSet};
 use std::rc::Rc;
+
+mod imports;
+mod instances;
 
 /// Nesting limit of component instances (a component that instantiates itself hits it).
 const MAX_DEPTH: usize = 24;
@@ -355,28 +358,7 @@ impl<'a> Elaborator<'a> {
                 if at == Where::Module {
                     return self.misplaced(scope, *span, "a declaration", at);
                 }
-                if self.reserved(scope, &name.ident) {
-                    return;
-                }
-                let index = match &name.index {
-                    Some(e) => match self.env.integer_in(scope, e, "an index") {
-                        Ok(i) => Some(i),
-                        Err(d) => return self.error(scope, d),
-                    },
-                    None => None,
-                };
-                let qualified = self.env.qualified(scope, &name.ident.name, index);
-                let id = self.env.decls.len();
-                self.env.decls.push(Decl {
-                    item: Rc::new(item.clone()),
-                    name: qualified,
-                    scope,
-                    name_span: name.span,
-                    used: false,
-                });
-                if let Err(d) = self.env.declare(scope, &name.ident, index, Named::Decl(id)) {
-                    self.error(scope, d);
-                }
+                self.declaration(item, name, scope);
             }
             Item::Instance {
                 name,
@@ -392,77 +374,11 @@ impl<'a> Elaborator<'a> {
                 }
                 self.instantiate(name, component, args, *span, scope, file);
             }
-            Item::For {
-                var,
-                from,
-                to,
-                inclusive,
-                items,
-                span,
-            } => {
+            Item::For { span, .. } => {
                 if at == Where::Module {
                     return self.misplaced(scope, *span, "for", at);
                 }
-                if self.reserved(scope, var) {
-                    return;
-                }
-                let bounds = self
-                    .env
-                    .integer_in(scope, from, "a loop bound")
-                    .and_then(|a| {
-                        self.env
-                            .integer_in(scope, to, "a loop bound")
-                            .map(|b| (a, b))
-                    });
-                let (a, b) = match bounds {
-                    Ok(x) => x,
-                    Err(d) => return self.error(scope, d),
-                };
-                let end = if *inclusive { b + 1 } else { b };
-                if end - a > MAX_LOOP {
-                    return self.error(
-                        scope,
-                        Diagnostic::error(Code::E0223, format!("this loop runs {} times", end - a))
-                            .at(*span, "too many iterations")
-                            .hint(format!(
-                                "loops are limited to {MAX_LOOP} iterations; check the bounds"
-                            )),
-                    );
-                }
-                let header = Span {
-                    end: to.span.end,
-                    ..*span
-                };
-                for i in a..end {
-                    let home = self.env.scopes[scope].home;
-                    let prefix = self.env.scopes[home].prefix.clone();
-                    let inner = self.env.new_scope(Some(scope), prefix, Some(home));
-                    self.env.scopes[inner].iteration = Some(Iteration {
-                        header,
-                        var: var.name.clone(),
-                        value: i,
-                        count: end - a,
-                    });
-                    let v = crate::model::eval::Value::scalar(
-                        i as f64,
-                        crate::model::eval::units::Dim::NONE,
-                    );
-                    let mut b = Env::binding(
-                        var,
-                        var.span,
-                        BindingKind::LoopVar,
-                        None,
-                        inner,
-                        None,
-                        Some(v),
-                    );
-                    b.used = true;
-                    let id = self.env.add_binding(b);
-                    self.env.scopes[inner]
-                        .names
-                        .insert(var.name.clone(), Named::Binding(id));
-                    self.items(items, inner, Where::Nested, file);
-                }
+                self.unroll(item, scope, file);
             }
             Item::If {
                 cond,
@@ -473,23 +389,7 @@ impl<'a> Elaborator<'a> {
                 if at == Where::Module {
                     return self.misplaced(scope, *span, "if", at);
                 }
-                let c = match self.env.eval_in(scope, cond) {
-                    Ok(crate::model::eval::Value::Scalar { value, dim }) if dim.is_none() => value != 0.0,
-                    Ok(v) => {
-                        return self.error(
-                            scope,
-                            Diagnostic::error(Code::E0209, format!("a condition must be a constant number, found {}", v.kind_name()))
-                                .at(cond.span, "not a condition")
-                                .hint("write `if elastic { ... }` with a `bool` parameter, or any dimensionless number (true when not 0)"),
-                        )
-                    }
-                    Err(d) => return self.error(scope, d),
-                };
-                let home = self.env.scopes[scope].home;
-                let prefix = self.env.scopes[home].prefix.clone();
-                let inner = self.env.new_scope(Some(scope), prefix, Some(home));
-                self.mention(if c { otherwise } else { then }, scope);
-                self.items(if c { then } else { otherwise }, inner, Where::Nested, file);
+                self.condition(cond, then, otherwise, scope, file);
             }
             Item::Export { items, span } => {
                 if at == Where::Main {
@@ -532,15 +432,11 @@ impl<'a> Elaborator<'a> {
         }
     }
 
-    fn instantiate(
-        &mut self,
-        name: &crate::syntax::ast::Name,
-        component: &Ident,
-        args: &[crate::syntax::ast::Arg],
-        span: Span,
-        scope: ScopeId,
-        file: &str,
-    ) {
+    /// A declaration (an entity or a joint) gets its qualified name in `scope`.
+    fn declaration(&mut self, item: &Item, name: &Name, scope: ScopeId) {
+        if self.reserved(scope, &name.ident) {
+            return;
+        }
         let index = match &name.index {
             Some(e) => match self.env.integer_in(scope, e, "an index") {
                 Ok(i) => Some(i),
@@ -548,383 +444,121 @@ impl<'a> Elaborator<'a> {
             },
             None => None,
         };
-        let (def, def_scope) = match self.env.lookup(scope, &component.name) {
-            Some(Named::Component(c, s)) => (c, s),
-            Some(_) => {
-                self.failed_instance(name, index, scope);
-                return self.error(
-                    scope,
-                    Diagnostic::error(Code::E0222, format!("`{}` is not a component", component.name))
-                        .at(component.span, "not a component")
-                        .hint("instantiate a component declared with `component NAME(...) { ... }` or imported with `use`"),
-                );
-            }
-            None => {
-                self.failed_instance(name, index, scope);
-                let candidates = self.env.visible(scope);
-                let d = Diagnostic::error(
-                    Code::E0201,
-                    format!("unknown component `{}`", component.name),
-                )
-                .at(component.span, "not declared");
-                let hint = match did_you_mean(&component.name, candidates.iter().map(|s| s.as_str())) {
-                    Some(s) => format!("did you mean `{s}`?"),
-                    None => "declare it with `component`, or import it, e.g. `use stdlib::rotor::lag_hinged_rotor`".to_string(),
-                };
-                return self.error(scope, d.hint(hint));
-            }
-        };
-        if self.depth >= MAX_DEPTH {
-            return self.error(
-                scope,
-                Diagnostic::error(Code::E0218, format!("components nest more than {MAX_DEPTH} deep"))
-                    .at(span, "instantiated here")
-                    .hint(format!("component `{}` probably instantiates itself, directly or through another component", def.name.name)),
-            );
-        }
-        self.out.instantiated.insert(def.span);
-        let prefix = format!("{}.", self.env.qualified(scope, &name.ident.name, index));
-        let inst = self.env.new_scope(Some(def_scope), prefix, None);
-        self.env.scopes[inst].instance = Some((def.name.name.clone(), span));
-        self.env.scopes[inst].caller = Some(scope);
-        if let Err(d) = self
-            .env
-            .declare(scope, &name.ident, index, Named::Instance(inst))
-        {
+        let qualified = self.env.qualified(scope, &name.ident.name, index);
+        let id = self.env.decls.len();
+        self.env.decls.push(Decl {
+            item: Rc::new(item.clone()),
+            name: qualified,
+            scope,
+            name_span: name.span,
+            used: false,
+        });
+        if let Err(d) = self.env.declare(scope, &name.ident, index, Named::Decl(id)) {
             self.error(scope, d);
         }
-        // Arguments.
-        let mut given: HashMap<&str, &crate::syntax::ast::Arg> = HashMap::new();
-        for a in args {
-            if let Some(first) = given.insert(&a.name.name, a) {
-                self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0203,
-                        format!("argument `{}` is given twice", a.name.name),
-                    )
-                    .at(a.name.span, "second value")
-                    .at(first.name.span, "first value")
-                    .hint("give each argument once"),
-                );
-            }
-            if !def.params.iter().any(|p| p.name.name == a.name.name) {
-                let names: Vec<&str> = def.params.iter().map(|p| p.name.name.as_str()).collect();
-                let d = Diagnostic::error(
-                    Code::E0215,
-                    format!(
-                        "component `{}` has no parameter `{}`",
-                        def.name.name, a.name.name
-                    ),
-                )
-                .at(a.name.span, "unknown argument");
-                let hint = match did_you_mean(&a.name.name, names.iter().copied()) {
-                    Some(s) => format!("did you mean `{s}`? Parameters: {}", names.join(", ")),
-                    None => format!("parameters: {}", names.join(", ")),
-                };
-                self.error(scope, d.hint(hint));
-            }
+    }
+
+    /// `for VAR in FROM..TO { ... }`: the body elaborated once per value, each in a scope of
+    /// its own that declares into the enclosing naming scope.
+    fn unroll(&mut self, item: &Item, scope: ScopeId, file: &str) {
+        let Item::For {
+            var,
+            from,
+            to,
+            inclusive,
+            items,
+            span,
+        } = item
+        else {
+            return;
+        };
+        if self.reserved(scope, var) {
+            return;
         }
-        for p in &def.params {
-            let Some(ty) = ParamType::parse(&p.ty.name) else {
-                continue;
-            };
-            let (expr, offset, eval_scope) = match (given.get(p.name.name.as_str()), &p.default) {
-                (Some(a), _) => (a.value.clone(), a.offset.clone(), scope),
-                (None, Some(d)) => (d.clone(), None, inst),
-                (None, None) => {
-                    self.error(
-                        scope,
-                        Diagnostic::error(
-                            Code::E0215,
-                            format!("`{}` needs argument `{}`", def.name.name, p.name.name),
-                        )
-                        .at(component.span, "missing argument")
-                        .at(p.span, "parameter declared here")
-                        .hint(format!(
-                            "add `{} = ...`: {}",
-                            p.name.name,
-                            ty.describe()
-                        )),
-                    );
-                    continue;
-                }
-            };
-            if ty.is_reference() && !matches!(expr.kind, crate::syntax::ast::ExprKind::Path { .. })
-            {
-                self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0215,
-                        format!(
-                            "argument `{}` of `{}` must name a {}",
-                            p.name.name,
-                            def.name.name,
-                            ty.name()
-                        ),
-                    )
-                    .at(expr.span, "not a name")
-                    .hint(ty.example()),
-                );
-                continue;
-            }
-            if let (Some(o), false) = (&offset, ty == ParamType::Marker) {
-                self.error(
-                    scope,
-                    Diagnostic::error(
-                        Code::E0215,
-                        format!(
-                            "argument `{}` of `{}` is a {}: it takes no offset",
-                            p.name.name,
-                            def.name.name,
-                            ty.name()
-                        ),
-                    )
-                    .at(o.span, "an offset")
-                    .at(p.ty.span, "declared here")
+        let bounds = self
+            .env
+            .integer_in(scope, from, "a loop bound")
+            .and_then(|a| {
+                self.env
+                    .integer_in(scope, to, "a loop bound")
+                    .map(|b| (a, b))
+            });
+        let (a, b) = match bounds {
+            Ok(x) => x,
+            Err(d) => return self.error(scope, d),
+        };
+        let end = if *inclusive { b + 1 } else { b };
+        if end - a > MAX_LOOP {
+            return self.error(
+                scope,
+                Diagnostic::error(Code::E0223, format!("this loop runs {} times", end - a))
+                    .at(*span, "too many iterations")
                     .hint(format!(
-                        "only `marker` arguments take `@ (x, y, z)`; {}",
-                        ty.example()
+                        "loops are limited to {MAX_LOOP} iterations; check the bounds"
                     )),
-                );
-                continue;
-            }
-            let mut b = Env::binding(
-                &p.name,
-                p.span,
-                BindingKind::Arg,
-                Some(expr),
-                eval_scope,
-                Some((ty, p.ty.span)),
-                None,
             );
-            b.component = Some(def.name.name.clone());
-            b.offset = offset;
-            // Arguments are part of a component's interface: never reported unused.
+        }
+        let header = Span {
+            end: to.span.end,
+            ..*span
+        };
+        for i in a..end {
+            let home = self.env.scopes[scope].home;
+            let prefix = self.env.scopes[home].prefix.clone();
+            let inner = self.env.new_scope(Some(scope), prefix, Some(home));
+            self.env.scopes[inner].iteration = Some(Iteration {
+                header,
+                var: var.name.clone(),
+                value: i,
+                count: end - a,
+            });
+            let v =
+                crate::model::eval::Value::scalar(i as f64, crate::model::eval::units::Dim::NONE);
+            let mut b = Env::binding(
+                var,
+                var.span,
+                BindingKind::LoopVar,
+                None,
+                inner,
+                None,
+                Some(v),
+            );
             b.used = true;
             let id = self.env.add_binding(b);
-            self.env.scopes[inst]
+            self.env.scopes[inner]
                 .names
-                .insert(p.name.name.clone(), Named::Binding(id));
-        }
-        self.depth += 1;
-        self.items(&def.items, inst, Where::Nested, file);
-        self.depth -= 1;
-        // Exports must name something the component declares.
-        if let Some(exports) = self.env.scopes[inst].exports.clone() {
-            for (n, alias) in exports {
-                if alias.is_none() && !self.env.scopes[inst].names.contains_key(&n) {
-                    let span = def.items.iter().find_map(|i| match i {
-                        Item::Export { items, .. } => {
-                            items.iter().find(|e| e.name.name == n).map(|e| e.name.span)
-                        }
-                        _ => None,
-                    });
-                    let mut d = Diagnostic::error(
-                        Code::E0201,
-                        format!(
-                            "component `{}` exports `{n}`, which it does not declare",
-                            def.name.name
-                        ),
-                    );
-                    if let Some(s) = span {
-                        d = d.at(s, "exported here");
-                    }
-                    self.error(
-                        inst,
-                        d.hint("declare it in the component, or write `export NAME = path`"),
-                    );
-                }
-            }
+                .insert(var.name.clone(), Named::Binding(id));
+            self.items(items, inner, Where::Nested, file);
         }
     }
 
-    /// Declares an instance that could not be made, so that the names through it stay silent
-    /// instead of each reporting it unknown.
-    fn failed_instance(
+    /// `if COND { ... } else { ... }`: the branch taken is elaborated, the other's names are
+    /// only mentioned.
+    fn condition(
         &mut self,
-        name: &crate::syntax::ast::Name,
-        index: Option<i64>,
-        scope: ScopeId,
-    ) {
-        let prefix = format!("{}.", self.env.qualified(scope, &name.ident.name, index));
-        let inst = self.env.new_scope(None, prefix, None);
-        self.env.scopes[inst].failed = true;
-        // A clash with another name is secondary to the failure reported.
-        let _ = self
-            .env
-            .declare(scope, &name.ident, index, Named::Instance(inst));
-    }
-
-    fn import(&mut self, target: &UseTarget, span: Span, scope: ScopeId, file: &str) {
-        let (module, item): (Vec<String>, Option<Ident>) = match target {
-            UseTarget::File(path) => {
-                let Some(ms) = self.load(
-                    &format!("\"{path}\""),
-                    LoadRequest::File { path, from: file },
-                    span,
-                    scope,
-                ) else {
-                    return;
-                };
-                return self.import_all(ms, scope, span);
-            }
-            UseTarget::Module(segs) => (segs.iter().map(|s| s.name.clone()).collect(), None),
-        };
-        // `use a::b::c`: module a::b::c entire, or item c of module a::b.
-        let whole = module.join("::");
-        if let Some(ms) = self.try_load(&module, span, scope, file) {
-            return self.import_all(ms, scope, span);
-        }
-        let _ = item;
-        if module.len() >= 2 {
-            let (m, last) = module.split_at(module.len() - 1);
-            if let Some(ms) = self.try_load(m, span, scope, file) {
-                let name = &last[0];
-                let Some(named) = self.env.scopes[ms].names.get(name).cloned() else {
-                    let names: Vec<String> = self.env.scopes[ms].names.keys().cloned().collect();
-                    let d = Diagnostic::error(
-                        Code::E0216,
-                        format!("module `{}` has no `{name}`", m.join("::")),
-                    )
-                    .at(span, "not found");
-                    let hint = match did_you_mean(name, names.iter().map(|s| s.as_str())) {
-                        Some(s) => format!("did you mean `{s}`?"),
-                        None => format!("it declares: {}", names.join(", ")),
-                    };
-                    return self.error(scope, d.hint(hint));
-                };
-                let ident = Ident {
-                    name: name.clone(),
-                    span,
-                };
-                if let Err(d) = self.env.declare(scope, &ident, None, named) {
-                    self.error(scope, d);
-                }
-                return;
-            }
-        }
-        if !self.errors.iter().any(|e| e.code == Code::E0217) {
-            let stdlib: Vec<&str> = crate::stdlib::MODULES.iter().map(|m| m.0).collect();
-            self.error(
-                scope,
-                Diagnostic::error(Code::E0216, format!("cannot find module `{whole}`"))
-                    .at(span, "not found")
-                    .hint(format!(
-                        "the standard library has: {}; your own modules are searched next to the model file and in the directories of MBD_PATH",
-                        stdlib.iter().map(|m| format!("stdlib::{m}")).collect::<Vec<_>>().join(", ")
-                    )),
-            );
-        }
-    }
-
-    fn import_all(&mut self, ms: ScopeId, scope: ScopeId, span: Span) {
-        let mut names: Vec<(String, Named)> = self.env.scopes[ms]
-            .names
-            .iter()
-            .filter(|(_, n)| matches!(n, Named::Component(..)))
-            .map(|(k, n)| (k.clone(), n.clone()))
-            .collect();
-        names.sort_by(|a, b| a.0.cmp(&b.0));
-        for (name, named) in names {
-            let ident = Ident { name, span };
-            if let Err(d) = self.env.declare(scope, &ident, None, named) {
-                self.error(scope, d);
-            }
-        }
-    }
-
-    fn try_load(
-        &mut self,
-        module: &[String],
-        span: Span,
+        cond: &Expr,
+        then: &[Item],
+        otherwise: &[Item],
         scope: ScopeId,
         file: &str,
-    ) -> Option<ScopeId> {
-        let key = module.join("::");
-        if module.first().map(|s| s.as_str()) == Some("stdlib") {
-            let name = module[1..].join("::");
-            let text = crate::stdlib::MODULES.iter().find(|m| m.0 == name)?.1;
-            return self.load_text(
-                &key,
-                &format!("stdlib/{name}.mbd"),
-                text.to_string(),
-                span,
-                scope,
-            );
-        }
-        self.load(
-            &key,
-            LoadRequest::Module {
-                path: module,
-                from: file,
-            },
-            span,
-            scope,
-        )
-    }
-
-    fn load(&mut self, key: &str, req: LoadRequest, span: Span, scope: ScopeId) -> Option<ScopeId> {
-        if let Some(&s) = self.modules.get(key) {
-            return Some(s);
-        }
-        if self.loading.iter().any(|k| k == key) {
-            return self.cycle(key, span, scope);
-        }
-        match self.loader.load(&req) {
-            Ok((name, text)) => self.load_text(key, &name, text, span, scope),
-            Err(None) => None,
-            Err(Some(msg)) => {
-                self.error(
+    ) {
+        let c = match self.env.eval_in(scope, cond) {
+            Ok(crate::model::eval::Value::Scalar { value, dim }) if dim.is_none() => value != 0.0,
+            Ok(v) => {
+                return self.error(
                     scope,
-                    Diagnostic::error(Code::E0216, format!("cannot read `{key}`: {msg}"))
-                        .at(span, "imported here")
-                        .hint("check the path; relative paths start at the importing file's directory"),
-                );
-                None
+                    Diagnostic::error(Code::E0209, format!("a condition must be a constant number, found {}", v.kind_name()))
+                        .at(cond.span, "not a condition")
+                        .hint("write `if elastic { ... }` with a `bool` parameter, or any dimensionless number (true when not 0)"),
+                )
             }
-        }
-    }
-
-    fn cycle(&mut self, key: &str, span: Span, scope: ScopeId) -> Option<ScopeId> {
-        let chain = self.loading.join(" -> ");
-        self.error(
-            scope,
-            Diagnostic::error(Code::E0217, format!("import cycle: {chain} -> {key}"))
-                .at(span, "imports a module that is still being loaded")
-                .hint("move what both modules need into a third module that imports neither"),
-        );
-        None
-    }
-
-    fn load_text(
-        &mut self,
-        key: &str,
-        name: &str,
-        text: String,
-        span: Span,
-        scope: ScopeId,
-    ) -> Option<ScopeId> {
-        if let Some(&s) = self.modules.get(key) {
-            return Some(s);
-        }
-        if self.loading.iter().any(|k| k == key) {
-            return self.cycle(key, span, scope);
-        }
-        let id = self.sources.add(name, text.clone());
-        let file = match crate::syntax::parse_file(&text, id) {
-            Ok(f) => f,
-            Err(d) => {
-                self.errors.push(d);
-                return None;
-            }
+            Err(d) => return self.error(scope, d),
         };
-        self.loading.push(key.to_string());
-        let ms = self.env.new_scope(None, String::new(), None);
-        self.items(&file.items, ms, Where::Module, name);
-        self.loading.pop();
-        self.modules.insert(key.to_string(), ms);
-        Some(ms)
+        let home = self.env.scopes[scope].home;
+        let prefix = self.env.scopes[home].prefix.clone();
+        let inner = self.env.new_scope(Some(scope), prefix, Some(home));
+        self.mention(if c { otherwise } else { then }, scope);
+        self.items(if c { then } else { otherwise }, inner, Where::Nested, file);
     }
 }
 

@@ -5,5 +5,6 @@
 
 pub(super) mod elaborate;
 pub(super) mod env;
+pub(super) mod evaluate;
 pub(super) mod resolve;
 pub(super) mod types;
