@@ -104,38 +104,13 @@ struct Builtin {
 }
 
 const F_X: &str = "f(x)";
-const NO_DOMAIN: Option<fn(f64) -> bool> = None;
+const RATIO: &[Param] = &[Param::Ratio];
+/// Two scalars of one dimension, named by the function in messages.
+const TWO_SCALARS: &[Param] = &[Param::Scalar(""), Param::Scalar("")];
+const TWO_VECTORS: &[Param] = &[Param::Vector, Param::Vector];
 
-const fn ratio(name: &'static str, domain: Option<fn(f64) -> bool>, apply: Apply) -> Builtin {
-    Builtin {
-        name,
-        params: &[Param::Ratio],
-        required: 1,
-        usage: F_X,
-        returns: Returns::Ratio,
-        domain,
-        apply,
-    }
-}
-
-const fn compare(
-    name: &'static str,
-    usage: &'static str,
-    returns: Returns,
-    apply: Apply,
-) -> Builtin {
-    Builtin {
-        name,
-        params: &[Param::Scalar(""), Param::Scalar("")],
-        required: 2,
-        usage,
-        returns,
-        domain: None,
-        apply,
-    }
-}
-
-const fn vectors(
+/// A row taking all its `params`, with no domain restriction.
+const fn builtin(
     name: &'static str,
     params: &'static [Param],
     usage: &'static str,
@@ -153,6 +128,20 @@ const fn vectors(
     }
 }
 
+impl Builtin {
+    /// Only the first `required` arguments must be given.
+    const fn optional_from(mut self, required: usize) -> Builtin {
+        self.required = required;
+        self
+    }
+
+    /// A constant first argument must satisfy `ok`.
+    const fn domain(mut self, ok: fn(f64) -> bool) -> Builtin {
+        self.domain = Some(ok);
+        self
+    }
+}
+
 fn sig(f: TimeFn, dim: Dim) -> Value {
     Value::from_parts(vec![f], dim)
 }
@@ -167,54 +156,42 @@ fn binary_of(op: Binary, a: &[Arg], dim: Dim) -> Result<Value, Diagnostic> {
 
 /// The built-ins, in the order hints list them.
 const BUILTINS: &[Builtin] = &[
-    ratio("sin", NO_DOMAIN, |a, d, _| unary_of(Unary::Sin, a, d)),
-    ratio("cos", NO_DOMAIN, |a, d, _| unary_of(Unary::Cos, a, d)),
-    ratio("tan", NO_DOMAIN, |a, d, _| unary_of(Unary::Tan, a, d)),
-    ratio("asin", Some(|c| (-1.0..=1.0).contains(&c)), |a, d, _| {
-        unary_of(Unary::Asin, a, d)
-    }),
-    ratio("acos", Some(|c| (-1.0..=1.0).contains(&c)), |a, d, _| {
-        unary_of(Unary::Acos, a, d)
-    }),
-    ratio("atan", NO_DOMAIN, |a, d, _| unary_of(Unary::Atan, a, d)),
-    compare("atan2", "atan2(y, x)", Returns::CommonRatio, |a, d, _| {
+    builtin("sin", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Sin, a, d)),
+    builtin("cos", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Cos, a, d)),
+    builtin("tan", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Tan, a, d)),
+    builtin("asin", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Asin, a, d))
+        .domain(|c| (-1.0..=1.0).contains(&c)),
+    builtin("acos", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Acos, a, d))
+        .domain(|c| (-1.0..=1.0).contains(&c)),
+    builtin("atan", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Atan, a, d)),
+    builtin("atan2", TWO_SCALARS, "atan2(y, x)", Returns::CommonRatio, |a, d, _| {
         binary_of(Binary::Atan2, a, d)
     }),
-    Builtin {
-        name: "sqrt",
-        params: &[Param::Scalar("`sqrt`")],
-        required: 1,
-        usage: F_X,
-        returns: Returns::Root,
-        domain: Some(|c| c >= 0.0),
-        apply: |a, d, _| unary_of(Unary::Sqrt, a, d),
-    },
-    Builtin {
-        name: "abs",
-        params: &[Param::Scalar("`abs`")],
-        required: 1,
-        usage: F_X,
-        returns: Returns::First,
-        domain: None,
-        apply: |a, d, _| unary_of(Unary::Abs, a, d),
-    },
-    ratio("exp", NO_DOMAIN, |a, d, _| unary_of(Unary::Exp, a, d)),
-    ratio("ln", Some(|c| c > 0.0), |a, d, _| unary_of(Unary::Ln, a, d)),
-    compare("min", "min(a, b)", Returns::Common, |a, d, _| {
+    builtin("sqrt", &[Param::Scalar("`sqrt`")], F_X, Returns::Root, |a, d, _| {
+        unary_of(Unary::Sqrt, a, d)
+    })
+    .domain(|c| c >= 0.0),
+    builtin("abs", &[Param::Scalar("`abs`")], F_X, Returns::First, |a, d, _| {
+        unary_of(Unary::Abs, a, d)
+    }),
+    builtin("exp", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Exp, a, d)),
+    builtin("ln", RATIO, F_X, Returns::Ratio, |a, d, _| unary_of(Unary::Ln, a, d))
+        .domain(|c| c > 0.0),
+    builtin("min", TWO_SCALARS, "min(a, b)", Returns::Common, |a, d, _| {
         binary_of(Binary::Min, a, d)
     }),
-    compare("max", "max(a, b)", Returns::Common, |a, d, _| {
+    builtin("max", TWO_SCALARS, "max(a, b)", Returns::Common, |a, d, _| {
         binary_of(Binary::Max, a, d)
     }),
-    vectors("norm", &[Param::Vector], "norm((x, y, z))", Returns::First, |a, d, _| {
+    builtin("norm", &[Param::Vector], "norm((x, y, z))", Returns::First, |a, d, _| {
         let v = a[0].vector();
         Ok(Value::scalar((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt(), d))
     }),
-    vectors("dot", &[Param::Vector, Param::Vector], "dot(a, b)", Returns::Product, |a, d, _| {
+    builtin("dot", TWO_VECTORS, "dot(a, b)", Returns::Product, |a, d, _| {
         let (u, v) = (a[0].vector(), a[1].vector());
         Ok(Value::scalar(u[0] * v[0] + u[1] * v[1] + u[2] * v[2], d))
     }),
-    vectors("cross", &[Param::Vector, Param::Vector], "cross(a, b)", Returns::Product, |a, d, _| {
+    builtin("cross", TWO_VECTORS, "cross(a, b)", Returns::Product, |a, d, _| {
         let (u, v) = (a[0].vector(), a[1].vector());
         Ok(Value::Vector {
             value: [
@@ -225,7 +202,7 @@ const BUILTINS: &[Builtin] = &[
             dim: d,
         })
     }),
-    vectors(
+    builtin(
         "rotate",
         &[
             Param::Axis,
@@ -245,20 +222,20 @@ const BUILTINS: &[Builtin] = &[
             })
         },
     ),
-    vectors(
+    builtin(
         "ramp",
         &[Param::Time, Param::Time],
         "ramp(start, end), e.g. ramp(0 s, 0.5 s)",
         Returns::Ratio,
         ramp,
     ),
-    vectors("step", &[Param::Time], "step(time), e.g. step(1 s)", Returns::Ratio, |a, d, _| {
+    builtin("step", &[Param::Time], "step(time), e.g. step(1 s)", Returns::Ratio, |a, d, _| {
         let t0 = a[0].number();
         Ok(sig(hold(vec![(t0, 0.0), (t0, 1.0)]), d))
     }),
-    Builtin {
-        name: "sine",
-        params: &[
+    builtin(
+        "sine",
+        &[
             Param::Scalar("the amplitude of `sine`"),
             Param::Fixed {
                 what: "the angular frequency of `sine`",
@@ -275,13 +252,12 @@ const BUILTINS: &[Builtin] = &[
                 angle: true,
             },
         ],
-        required: 2,
-        usage: "sine(amplitude, omega, phase), e.g. sine(20 N, 10 rad/s)",
-        returns: Returns::First,
-        domain: None,
-        apply: sine,
-    },
-    vectors("constant", &[Param::Any], "constant(value)", Returns::Ratio, |a, _, _| {
+        "sine(amplitude, omega, phase), e.g. sine(20 N, 10 rad/s)",
+        Returns::First,
+        sine,
+    )
+    .optional_from(2),
+    builtin("constant", &[Param::Any], "constant(value)", Returns::Ratio, |a, _, _| {
         match &a[0] {
             Arg::Value(v) => Ok(v.clone()),
             _ => unreachable!("the table gives a value"),
