@@ -3,6 +3,11 @@
 //! Contract: resolves names, evaluates params and properties with their units, checks
 //! dimensions and topology, and fixes the order of the unknowns (each multiplier after the
 //! unknowns it couples). Reports every error it finds. Must not know integrators or faer.
+//!
+//! Its steps live in folders: `scope/` (names, scopes, elaboration, resolution), `eval/`
+//! (values, units, expressions and built-in functions), `build/` (entities from declarations,
+//! outputs), `check/` (topology and the numbering of the unknowns); `settings.rs` reads the
+//! `solve` block. This file holds the stage's public types.
 
 mod build;
 mod check;

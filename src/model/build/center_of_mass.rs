@@ -2,6 +2,9 @@
 //! body and beam declared in it, recursively) or a family of them, each with the concentrated
 //! masses it carries. The runtime weighs each mass centre as its element's inertial forces do
 //! (a rigid body's `x + R eta`, a beam's section mass at the inertial quadrature points).
+//!
+//! Contract: resolves the call to bodies and beams and builds `Probe::CenterOfMass` channels; must
+//! not weigh the masses (the runtime does).
 
 use super::output_calls::segment;
 use super::probes::AXES;

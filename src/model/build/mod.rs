@@ -1,6 +1,9 @@
 //! Building the model: elaborate the files, then evaluate every declaration into bodies,
 //! beams, joints, springs and loads, then check the topology and number the unknowns.
 //! Every error found is reported; the model is returned only if there are none.
+//!
+//! Contract: turns the elaborated scopes into a `Model` of SI values, reporting every error once;
+//! must not know integrators, the runtime or faer, nor read files (a `Loader` supplies module texts).
 
 mod beams;
 mod bodies;

@@ -6,6 +6,9 @@
 //! center_of_mass(rotor)` gives the centre of mass of a body, a beam, a component instance or
 //! a family of them (`cm.x`, `cm.y`, `cm.z`; `.velocity`, `.acceleration` and one component
 //! may follow the call). Arguments are references, positional or named.
+//!
+//! Contract: resolves the arguments and builds the probes; must not compute the coordinates (the
+//! runtime does).
 
 use super::{Builder, Built};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};

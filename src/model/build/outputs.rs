@@ -1,4 +1,7 @@
 //! Output channels: `output x = bob.position.x, tension = link.force, rotor.lag[1].angle`.
+//!
+//! Contract: resolves each output path and names its columns, each once (the quantities of each
+//! family of entity are in `probes.rs`); must not know the runtime.
 
 use super::{Builder, Built};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};

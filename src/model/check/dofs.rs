@@ -5,6 +5,8 @@
 //! and fill low. Invariant: every joint's extra unknown and multipliers come right after the
 //! last node it couples, so eliminating a multiplier meets a non-zero pivot (THEORY §6) and the
 //! factorization needs no pivoting.
+//!
+//! Contract: reads a complete model; must not know the syntax, the scopes or the runtime.
 
 use crate::model::{Attach, BodyKind, Marker, Model};
 use serde::Serialize;

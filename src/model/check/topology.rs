@@ -8,6 +8,8 @@
 //!
 //! The Jacobian is taken with respect to virtual displacements and rotations of every node,
 //! which has the rank of the Jacobian in any rotation parameters.
+//!
+//! Contract: reads a complete model and reports; must not change it, nor know the runtime.
 
 use super::dofs::{attach_nodes, Node};
 use crate::diagnostics::{Code, Diagnostic, Sink};

@@ -7,6 +7,9 @@
 //! and its expression names no angle anywhere: no `rad`, `deg` or `rev` in a unit (`rad/s`
 //! counts), no `pi`, no inverse trigonometric function, also through the params, lets,
 //! functions and arguments it names.
+//!
+//! Contract: reads expressions and the bindings they name; must not evaluate them (the caller
+//! gives the value).
 
 use super::units;
 use crate::diagnostics::{Code, Diagnostic};

@@ -4,6 +4,9 @@
 //! components are functions of time ([`TimeFn`]). Arithmetic on constants folds to constants,
 //! so a signal appears only where `t` or a time function does; declarations that need a
 //! constant reject signals (E0401).
+//!
+//! Contract: evaluates one expression through [`Names`]; must not know scopes, declarations or
+//! entities.
 
 pub(super) mod angles;
 mod arith;

@@ -4,6 +4,10 @@
 //!
 //! Within one scope, names are declared first (params, lets, functions, components, imports)
 //! and structure second (declarations, loops, instances), so order never matters.
+//!
+//! Contract: declares names and scopes and collects what the build needs (outputs, initial
+//! motions, solutions, the `solve` block); must not build entities, nor evaluate more than
+//! indices, loop bounds and conditions.
 
 use super::env::{Binding, BindingKind, Decl, Env, Named, ScopeId};
 use super::types::ParamType;

@@ -9,6 +9,8 @@
 //! as its parent, while its arguments are evaluated in the caller's scope. A `for` body gets a
 //! scope of its own for the loop variable and its lets, but declares its bodies in the
 //! enclosing naming scope (its `home`), so `blade[i]` is visible after the loop.
+//!
+//! Contract: holds names and evaluates bindings lazily; must not build entities.
 
 use super::types::ParamType;
 use crate::diagnostics::{Code, Diagnostic, Iteration};

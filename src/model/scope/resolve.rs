@@ -2,6 +2,8 @@
 //! exports), indexed families, export aliases and reference arguments (`hub: marker`, resolved
 //! where the instance is written, with the offsets of marker arguments collected for the
 //! marker they name).
+//!
+//! Contract: resolves paths against scopes; must not evaluate properties or build entities.
 
 use super::env::{builtin, secondary, BindingId, Env, Member, Named, Offset, Ref, ScopeId, Seg};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};

@@ -1,4 +1,6 @@
 //! The types of component parameters: `blades: int`, `hinge_offset: length`, `hub: marker`.
+//!
+//! Contract: parses a parameter type and checks a value against it; must not know scopes.
 
 use crate::model::eval::units::{self, Dim, Quantity};
 use crate::model::eval::Value;
