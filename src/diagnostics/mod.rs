@@ -54,6 +54,11 @@ pub struct Iteration {
 impl Diagnostic {
     /// An error: `code` is an error code (`E...`); warnings are built by [`Diagnostic::warning`].
     pub fn error(code: Code, message: impl Into<String>) -> Diagnostic {
+        debug_assert!(
+            !code.is_warning(),
+            "{} is a warning code: use Diagnostic::warning",
+            code.as_str()
+        );
         Diagnostic::new(code, message)
     }
 
