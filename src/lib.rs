@@ -307,7 +307,7 @@ pub fn run_with_progress(
                     NoticeKind::VelocityProjected => Code::W0601,
                     NoticeKind::PositionProjected => Code::W0602,
                 };
-                let mut d = Diagnostic::error(code, n.detail).hint(code.doc().to_string());
+                let mut d = Diagnostic::warning(code, n.detail).hint(code.doc().to_string());
                 if let Some(span) = n.entity.and_then(|e| l.provenance.spans.get(e)) {
                     d = d.at(*span, "this joint");
                 }

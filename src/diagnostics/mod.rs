@@ -52,7 +52,24 @@ pub struct Iteration {
 }
 
 impl Diagnostic {
+    /// An error: `code` is an error code (`E...`); warnings are built by [`Diagnostic::warning`].
     pub fn error(code: Code, message: impl Into<String>) -> Diagnostic {
+        debug_assert!(
+            !code.is_warning(),
+            "{} is a warning code: use Diagnostic::warning",
+            code.as_str()
+        );
+        Diagnostic::new(code, message)
+    }
+
+    /// A warning: `code` is a warning code (`W...`).
+    pub fn warning(code: Code, message: impl Into<String>) -> Diagnostic {
+        debug_assert!(code.is_warning(), "{} is not a warning code", code.as_str());
+        Diagnostic::new(code, message)
+    }
+
+    /// The severity is the code's, known from the registry (`Code::is_warning`).
+    fn new(code: Code, message: impl Into<String>) -> Diagnostic {
         Diagnostic {
             code,
             severity: if code.is_warning() {

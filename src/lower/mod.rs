@@ -122,12 +122,19 @@ impl Lower<'_> {
     }
 }
 
-pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
-    if let Some(d) = unsupported(model) {
-        return Err(d);
-    }
+/// The rotating nodes: each rigid body's, then each beam node's, with the unknowns of their
+/// rotation and translation.
+struct Nodes {
+    node_of: Vec<Option<usize>>,
+    beam_nodes: Vec<Vec<usize>>,
+    rotations: Vec<usize>,
+    translations: Vec<usize>,
+    /// How many are rigid bodies' (the first ones).
+    rigid: usize,
+}
+
+fn nodes(model: &Model) -> Nodes {
     let dofs = &model.dofs;
-    let n = dofs.len();
     let mut node_of = Vec::new();
     let mut rotations = Vec::new();
     let mut translations = Vec::new();
@@ -140,7 +147,7 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
             node_of.push(None);
         }
     }
-    let rigid_nodes = rotations.len();
+    let rigid = rotations.len();
     let mut beam_nodes = Vec::new();
     for (bi, b) in model.beams.iter().enumerate() {
         let mut ids = Vec::new();
@@ -151,64 +158,65 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
         }
         beam_nodes.push(ids);
     }
-    let rotations_len = rotations.len();
-    let lw = Lower {
-        model,
+    Nodes {
         node_of,
         beam_nodes,
-    };
+        rotations,
+        translations,
+        rigid,
+    }
+}
+
+/// The runtime entities (bodies, beams, joints, springs, loads, in that order) and where
+/// each was declared.
+fn entities(model: &Model) -> (Vec<Entity>, Vec<Span>) {
     let mut entities = Vec::new();
     let mut spans = Vec::new();
+    let mut add = |name: &str, kind: String, span: Span| {
+        entities.push(Entity {
+            name: name.to_string(),
+            kind,
+        });
+        spans.push(span);
+    };
     for b in &model.bodies {
-        entities.push(Entity {
-            name: b.name.clone(),
-            kind: match b.kind {
-                BodyKind::PointMass => "point mass",
-                BodyKind::Rigid => "rigid body",
-            }
-            .to_string(),
-        });
-        spans.push(b.span);
+        let kind = match b.kind {
+            BodyKind::PointMass => "point mass",
+            BodyKind::Rigid => "rigid body",
+        };
+        add(&b.name, kind.to_string(), b.span);
     }
-    let nb = entities.len();
     for b in &model.beams {
-        entities.push(Entity {
-            name: b.name.clone(),
-            kind: "beam".to_string(),
-        });
-        spans.push(b.span);
+        add(&b.name, "beam".to_string(), b.span);
     }
-    let njoint0 = entities.len();
     for j in &model.joints {
-        entities.push(Entity {
-            name: j.name.clone(),
-            kind: format!("{} joint", j.kind.name()),
-        });
-        spans.push(j.span);
+        add(&j.name, format!("{} joint", j.kind.name()), j.span);
     }
+    for s in &model.springs {
+        add(&s.name, "spring".to_string(), s.span);
+    }
+    for l in &model.loads {
+        add(&l.name, "load".to_string(), l.span);
+    }
+    (entities, spans)
+}
+
+pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
+    if let Some(d) = unsupported(model) {
+        return Err(d);
+    }
+    let n = model.dofs.len();
+    let nodes = nodes(model);
+    let rotations_len = nodes.rotations.len();
+    let lw = Lower {
+        model,
+        node_of: nodes.node_of,
+        beam_nodes: nodes.beam_nodes,
+    };
+    let (entities, spans) = entities(model);
     let mut elements = Vec::new();
-    let mut initial = State::zeros(n, rotations.len());
-    for (bi, b) in model.bodies.iter().enumerate() {
-        let d = lw.body_dofs(bi);
-        for k in 0..3 {
-            initial.q[d[k]] = b.position[k];
-            initial.v[d[k]] = b.velocity[k];
-        }
-        match lw.node_of[bi] {
-            Some(node) => {
-                elements.push(Element::RigidBody(rigid(b, &d, node, model.gravity)));
-                initial.rot[node] = NodeRotation {
-                    w: b.angular_velocity,
-                    ..NodeRotation::REST
-                };
-            }
-            None => elements.push(Element::PointMass(PointMass {
-                dofs: [d[0], d[1], d[2]],
-                mass: b.mass,
-                gravity: model.gravity,
-            })),
-        }
-    }
+    let mut initial = State::zeros(n, rotations_len);
+    lw.bodies(&mut elements, &mut initial);
     // Bodies are elements 0..nb; each beam lowers to a run of elements (with its masses).
     let mut beam_elements = Vec::new();
     for (bi, b) in model.beams.iter().enumerate() {
@@ -229,51 +237,12 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
         elements.extend(lowered.forces.into_iter().map(Element::Spring));
     }
     for s in &model.springs {
-        entities.push(Entity {
-            name: s.name.clone(),
-            kind: "spring".to_string(),
-        });
-        spans.push(s.span);
         elements.extend(joints::spring(&lw, s).into_iter().map(Element::Spring));
     }
     for l in &model.loads {
-        entities.push(Entity {
-            name: l.name.clone(),
-            kind: "load".to_string(),
-        });
-        spans.push(l.span);
         elements.push(Element::Load(joints::load(&lw, l)));
     }
-    let mut unknowns = Vec::with_capacity(n);
-    let mut owners = Vec::with_capacity(n);
-    for (i, u) in dofs.unknowns.iter().enumerate() {
-        let (kind, owner) = match *u {
-            Unknown::Translation { body, .. } => (UnknownKind::Coordinate, body),
-            Unknown::Rotation { body, axis } => match lw.node_of[body] {
-                Some(node) => (UnknownKind::Rotation { node, axis }, body),
-                None => (UnknownKind::Coordinate, body),
-            },
-            Unknown::JointAngle { joint } => (UnknownKind::Coordinate, njoint0 + joint),
-            Unknown::Multiplier { joint, .. } => (
-                if rate_rows[i] {
-                    UnknownKind::RateMultiplier
-                } else {
-                    UnknownKind::Multiplier
-                },
-                njoint0 + joint,
-            ),
-            Unknown::NodeTranslation { beam, .. } => (UnknownKind::Coordinate, nb + beam),
-            Unknown::NodeRotation { beam, node, axis } => (
-                UnknownKind::Rotation {
-                    node: lw.beam_nodes[beam][node],
-                    axis,
-                },
-                nb + beam,
-            ),
-        };
-        unknowns.push(kind);
-        owners.push(owner);
-    }
+    let (unknowns, owners) = lw.unknowns(&rate_rows);
     let channels = model
         .outputs
         .iter()
@@ -285,9 +254,9 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
     let system = System {
         unknowns,
         owners,
-        rotations,
-        coupled: (0..rotations_len).map(|k| k < rigid_nodes).collect(),
-        translations,
+        rotations: nodes.rotations,
+        coupled: (0..rotations_len).map(|k| k < nodes.rigid).collect(),
+        translations: nodes.translations,
         entities,
         elements,
         initial,
@@ -295,6 +264,74 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
         length_scale: length_scale(model),
     };
     Ok((system, Provenance { spans }))
+}
+
+impl Lower<'_> {
+    /// Each body's element and its initial state.
+    fn bodies(&self, elements: &mut Vec<Element>, initial: &mut State) {
+        let model = self.model;
+        for (bi, b) in model.bodies.iter().enumerate() {
+            let d = self.body_dofs(bi);
+            for k in 0..3 {
+                initial.q[d[k]] = b.position[k];
+                initial.v[d[k]] = b.velocity[k];
+            }
+            match self.node_of[bi] {
+                Some(node) => {
+                    elements.push(Element::RigidBody(rigid(b, &d, node, model.gravity)));
+                    initial.rot[node] = NodeRotation {
+                        w: b.angular_velocity,
+                        ..NodeRotation::REST
+                    };
+                }
+                None => elements.push(Element::PointMass(PointMass {
+                    dofs: [d[0], d[1], d[2]],
+                    mass: b.mass,
+                    gravity: model.gravity,
+                })),
+            }
+        }
+    }
+
+    /// The kind of each unknown and the entity it belongs to (`rate_rows`: which
+    /// multipliers are of rate rows).
+    fn unknowns(&self, rate_rows: &[bool]) -> (Vec<UnknownKind>, Vec<usize>) {
+        let model = self.model;
+        let n = model.dofs.len();
+        let nb = model.bodies.len();
+        let njoint0 = nb + model.beams.len();
+        let mut unknowns = Vec::with_capacity(n);
+        let mut owners = Vec::with_capacity(n);
+        for (i, u) in model.dofs.unknowns.iter().enumerate() {
+            let (kind, owner) = match *u {
+                Unknown::Translation { body, .. } => (UnknownKind::Coordinate, body),
+                Unknown::Rotation { body, axis } => match self.node_of[body] {
+                    Some(node) => (UnknownKind::Rotation { node, axis }, body),
+                    None => (UnknownKind::Coordinate, body),
+                },
+                Unknown::JointAngle { joint } => (UnknownKind::Coordinate, njoint0 + joint),
+                Unknown::Multiplier { joint, .. } => (
+                    if rate_rows[i] {
+                        UnknownKind::RateMultiplier
+                    } else {
+                        UnknownKind::Multiplier
+                    },
+                    njoint0 + joint,
+                ),
+                Unknown::NodeTranslation { beam, .. } => (UnknownKind::Coordinate, nb + beam),
+                Unknown::NodeRotation { beam, node, axis } => (
+                    UnknownKind::Rotation {
+                        node: self.beam_nodes[beam][node],
+                        axis,
+                    },
+                    nb + beam,
+                ),
+            };
+            unknowns.push(kind);
+            owners.push(owner);
+        }
+        (unknowns, owners)
+    }
 }
 
 /// The rigid body element: centre of mass and inertia about the reference point, in

@@ -3,30 +3,21 @@
 //! Contract: resolves names, evaluates params and properties with their units, checks
 //! dimensions and topology, and fixes the order of the unknowns (each multiplier after the
 //! unknowns it couples). Reports every error it finds. Must not know integrators or faer.
+//!
+//! Its steps live in folders: `scope/` (names, scopes, elaboration, resolution), `eval/`
+//! (values, units, expressions and built-in functions), `build/` (entities from declarations,
+//! outputs), `check/` (topology and the numbering of the unknowns); `settings.rs` reads the
+//! `solve` block. This file holds the stage's public types.
 
-mod angles;
-mod beams;
-mod bodies;
 mod build;
-mod center_of_mass;
-mod connect;
-pub mod dofs;
-mod elaborate;
-mod env;
+mod check;
 pub mod eval;
-mod exact;
-pub use exact::channel_dim;
-mod output_calls;
-mod outputs;
-mod resolve;
-mod settings;
-pub mod topology;
-mod types;
-pub mod units;
+mod scope;
 
-pub use build::{build, check_library};
+pub use build::{build, channel_dim, check_library};
+pub use check::{dofs, topology};
 pub use dofs::DofMap;
-pub use eval::Value;
+pub use eval::{units, Value};
 
 use crate::runtime::timefn::TimeFn;
 pub use crate::runtime::Coleman;

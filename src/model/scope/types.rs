@@ -1,7 +1,9 @@
 //! The types of component parameters: `blades: int`, `hinge_offset: length`, `hub: marker`.
+//!
+//! Contract: parses a parameter type and checks a value against it; must not know scopes.
 
-use super::eval::Value;
-use super::units::{self, Dim, Quantity};
+use crate::model::eval::units::{self, Dim, Quantity};
+use crate::model::eval::Value;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ParamType {

@@ -6,11 +6,14 @@
 //! center_of_mass(rotor)` gives the centre of mass of a body, a beam, a component instance or
 //! a family of them (`cm.x`, `cm.y`, `cm.z`; `.velocity`, `.acceleration` and one component
 //! may follow the call). Arguments are references, positional or named.
+//!
+//! Contract: resolves the arguments and builds the probes; must not compute the coordinates (the
+//! runtime does).
 
-use super::build::{Builder, Built};
-use super::env::{Member, Ref, ScopeId, Seg};
-use super::*;
+use super::{Builder, Built};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::model::scope::env::{Member, Ref, ScopeId, Seg};
+use crate::model::*;
 use crate::syntax::ast::{Ident, OutputArg, OutputCall};
 
 /// The output functions and their parameters, in positional order.

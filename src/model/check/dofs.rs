@@ -5,8 +5,10 @@
 //! and fill low. Invariant: every joint's extra unknown and multipliers come right after the
 //! last node it couples, so eliminating a multiplier meets a non-zero pivot (THEORY §6) and the
 //! factorization needs no pivoting.
+//!
+//! Contract: reads a complete model; must not know the syntax, the scopes or the runtime.
 
-use super::{Attach, BodyKind, Model};
+use crate::model::{Attach, BodyKind, Marker, Model};
 use serde::Serialize;
 use std::collections::VecDeque;
 
@@ -94,42 +96,42 @@ pub fn attach_nodes(model: &Model, a: &Attach) -> Vec<Node> {
     }
 }
 
+/// What couples nodes: each joint's and spring's nodes, each beam element's; the joints'
+/// groups first, one per joint.
+fn coupling_groups(model: &Model, index: &impl Fn(Node) -> usize) -> Vec<Vec<usize>> {
+    let mut groups: Vec<Vec<usize>> = Vec::new();
+    let nodes_of = |markers: &[Marker; 2]| -> Vec<usize> {
+        markers
+            .iter()
+            .flat_map(|m| attach_nodes(model, &m.attach))
+            .map(index)
+            .collect()
+    };
+    for j in &model.joints {
+        groups.push(nodes_of(&j.markers));
+    }
+    for s in &model.springs {
+        groups.push(nodes_of(&s.markers));
+    }
+    for (bi, b) in model.beams.iter().enumerate() {
+        for e in 0..b.elements {
+            let first = e * (b.order - 1);
+            groups.push(
+                (first..first + b.order)
+                    .map(|k| index(Node::BeamNode { beam: bi, node: k }))
+                    .collect(),
+            );
+        }
+    }
+    groups
+}
+
 impl DofMap {
     pub fn new(model: &Model) -> DofMap {
         let (nodes, index) = node_index(model);
         let n = nodes.len();
-        // Coupling groups: joints and springs (their nodes), beam elements.
-        let mut groups: Vec<Vec<usize>> = Vec::new();
-        let mut joint_nodes = Vec::new();
-        for j in &model.joints {
-            let g: Vec<usize> = j
-                .markers
-                .iter()
-                .flat_map(|m| attach_nodes(model, &m.attach))
-                .map(&index)
-                .collect();
-            joint_nodes.push(g.clone());
-            groups.push(g);
-        }
-        for s in &model.springs {
-            groups.push(
-                s.markers
-                    .iter()
-                    .flat_map(|m| attach_nodes(model, &m.attach))
-                    .map(&index)
-                    .collect(),
-            );
-        }
-        for (bi, b) in model.beams.iter().enumerate() {
-            for e in 0..b.elements {
-                let first = e * (b.order - 1);
-                groups.push(
-                    (first..first + b.order)
-                        .map(|k| index(Node::BeamNode { beam: bi, node: k }))
-                        .collect(),
-                );
-            }
-        }
+        let groups = coupling_groups(model, &index);
+        let joint_nodes = &groups[..model.joints.len()];
         let mut adj: Vec<Vec<usize>> = vec![Vec::new(); n];
         for g in &groups {
             for &a in g {
@@ -145,13 +147,6 @@ impl DofMap {
         for (r, &v) in perm.iter().enumerate() {
             rank[v] = r;
         }
-        let mut map = DofMap {
-            body_start: vec![0; model.bodies.len()],
-            node_start: model.beams.iter().map(|b| vec![0; b.nodes.len()]).collect(),
-            joint_start: vec![0; model.joints.len()],
-            joint_extra: vec![None; model.joints.len()],
-            ..Default::default()
-        };
         // Joints by the position of their last node (joints to ground only: that node).
         let mut after: Vec<Vec<usize>> = vec![Vec::new(); n];
         for (ji, g) in joint_nodes.iter().enumerate() {
@@ -159,7 +154,22 @@ impl DofMap {
                 after[last].push(ji);
             }
         }
-        for &v in &perm {
+        let mut map = DofMap::number(model, &nodes, &perm, &after);
+        map.bandwidth = map.bandwidth_of(model, &nodes, &groups);
+        map
+    }
+
+    /// Numbers the unknowns node by node in the order `perm`, each joint's extra unknown and
+    /// multipliers right after the node it comes `after`.
+    fn number(model: &Model, nodes: &[Node], perm: &[usize], after: &[Vec<usize>]) -> DofMap {
+        let mut map = DofMap {
+            body_start: vec![0; model.bodies.len()],
+            node_start: model.beams.iter().map(|b| vec![0; b.nodes.len()]).collect(),
+            joint_start: vec![0; model.joints.len()],
+            joint_extra: vec![None; model.joints.len()],
+            ..Default::default()
+        };
+        for &v in perm {
             let node = nodes[v];
             map.order.push(node);
             match node {
@@ -192,11 +202,15 @@ impl DofMap {
                 );
             }
         }
-        // Bandwidth over every coupling.
-        let dofs_of = |map: &DofMap, v: usize| -> (usize, usize) {
+        map
+    }
+
+    /// The bandwidth over every coupling.
+    fn bandwidth_of(&self, model: &Model, nodes: &[Node], groups: &[Vec<usize>]) -> usize {
+        let dofs_of = |v: usize| -> (usize, usize) {
             match nodes[v] {
                 Node::Body { body } => {
-                    let s = map.body_start[body];
+                    let s = self.body_start[body];
                     (
                         s,
                         s + if model.bodies[body].kind == BodyKind::Rigid {
@@ -207,37 +221,36 @@ impl DofMap {
                     )
                 }
                 Node::BeamNode { beam, node } => {
-                    let s = map.node_start[beam][node];
+                    let s = self.node_start[beam][node];
                     (s, s + 5)
                 }
             }
         };
         let mut bw = 0;
-        for v in 0..n {
-            let (lo, hi) = dofs_of(&map, v);
+        for v in 0..nodes.len() {
+            let (lo, hi) = dofs_of(v);
             bw = bw.max(hi - lo);
         }
         for (gi, g) in groups.iter().enumerate() {
             let mut lo = usize::MAX;
             let mut hi = 0;
             for &v in g {
-                let (a, b) = dofs_of(&map, v);
+                let (a, b) = dofs_of(v);
                 lo = lo.min(a);
                 hi = hi.max(b);
             }
             if gi < model.joints.len() {
                 let j = &model.joints[gi];
-                let s = map.joint_start[gi];
+                let s = self.joint_start[gi];
                 let last = s + j.kind.multipliers().max(1) - 1;
-                lo = lo.min(map.joint_extra[gi].unwrap_or(s)).min(s);
+                lo = lo.min(self.joint_extra[gi].unwrap_or(s)).min(s);
                 hi = hi.max(last);
             }
             if lo <= hi {
                 bw = bw.max(hi - lo);
             }
         }
-        map.bandwidth = bw;
-        map
+        bw
     }
 
     pub fn len(&self) -> usize {

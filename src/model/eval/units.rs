@@ -1,6 +1,9 @@
 //! Physical dimensions and the unit table. Values are stored in SI; angles are dimensionless
 //! (radians), so `rad`, `deg`, `rev` are pure numbers; `rpm` (revolutions per minute) and `Hz`
 //! (cycles per second) are frequencies that carry the 2 pi of a cycle: `1 Hz` is 2 pi rad/s.
+//!
+//! Contract: plain data (dimensions, units, the quantities named in messages); must not know
+//! expressions or names.
 
 use serde::Serialize;
 use std::fmt;

@@ -3,10 +3,10 @@
 //! the settings module's ([`Settings::resolve`], called here to report the file's mistakes with
 //! the rest of the model's).
 
-use super::build::Builder;
-use super::env::ScopeId;
-use super::units::Dim;
-use super::*;
+use super::Builder;
+use crate::model::eval::units::Dim;
+use crate::model::scope::env::ScopeId;
+use crate::model::*;
 use crate::settings::{Field, Kind, Request, Settings, Written};
 use crate::syntax::ast::{Block, ExprKind, Item, Prop};
 

@@ -2,11 +2,14 @@
 //! exports), indexed families, export aliases and reference arguments (`hub: marker`, resolved
 //! where the instance is written, with the offsets of marker arguments collected for the
 //! marker they name).
+//!
+//! Contract: resolves paths against scopes; must not evaluate properties or build entities.
 
-use super::env::{builtin, secondary, Env, Member, Named, Offset, Ref, ScopeId, Seg};
+use super::env::{builtin, secondary, BindingId, Env, Member, Named, Offset, Ref, ScopeId, Seg};
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
 use crate::source::Span;
 use crate::syntax::ast::{Expr, ExprKind, Path};
+use std::collections::BTreeMap;
 
 impl Env {
     /// Evaluates the index and argument expressions of a path in `scope`.
@@ -126,70 +129,16 @@ impl Env {
         rest: &[Seg],
         span: Span,
     ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
-        let name = &seg.name.name;
-        let not_indexed = |what: &str| {
-            Diagnostic::error(
-                Code::E0214,
-                format!("`{name}` is {what}, not an indexed family"),
-            )
-            .at(
-                seg.index.map(|i| i.1).unwrap_or(seg.span),
-                "index given here",
-            )
-            .hint(format!("write `{name}` without an index"))
-        };
         let r = match named {
             Named::Binding(b) => {
                 if seg.index.is_some() {
-                    return Err(not_indexed("a value"));
+                    return Err(not_indexed(seg, "a value"));
                 }
-                let is_ref = self.bindings[b]
-                    .ty
-                    .as_ref()
-                    .map(|t| t.0.is_reference())
-                    .unwrap_or(false);
-                if is_ref {
-                    // A marker or body argument: resolve what the caller wrote, in the caller's scope.
-                    self.bindings[b].used = true;
-                    let (expr, bscope) = (self.bindings[b].expr.clone(), self.bindings[b].scope);
-                    let Some(Expr {
-                        kind: ExprKind::Path { path },
-                        ..
-                    }) = expr
-                    else {
-                        return Err(secondary(span));
-                    };
-                    if let Some(offset) = self.bindings[b].offset.clone() {
-                        let shown = format!("{} @ ...", path.text());
-                        if let Some(next) = rest.first() {
-                            return Err(Diagnostic::error(
-                                Code::E0222,
-                                format!("`{name}` is the point `{shown}`: it has no `{}`", next.name.name),
-                            )
-                            .at(next.span, "after a point with an offset")
-                            .hint("a marker passed with an offset (`@`) has no markers or quantities of its own: use it where a marker goes (a joint, a spring, a load), or pass the marker without the offset"));
-                        }
-                        match self.offsets.as_mut() {
-                            Some(list) => list.push((offset, bscope)),
-                            None => {
-                                return Err(Diagnostic::error(
-                                    Code::E0222,
-                                    format!("`{name}` is the point `{shown}`, usable only as a marker"),
-                                )
-                                .at(span, "not used as a marker")
-                                .hint("a marker argument with an offset goes where a marker goes (a joint, a spring, a load); pass it without `@` to use it here"))
-                            }
-                        }
-                    }
-                    let mut segs = self.segs(bscope, &path)?;
-                    segs.extend_from_slice(rest);
-                    return self.resolve(bscope, &segs, span);
-                }
-                Ref::Binding(b)
+                return self.follow_binding(b, seg, rest, span);
             }
             Named::Decl(d) => {
                 if seg.index.is_some() {
-                    return Err(not_indexed("a single declaration"));
+                    return Err(not_indexed(seg, "a single declaration"));
                 }
                 self.decls[d].used = true;
                 Ref::Decl(d)
@@ -197,57 +146,123 @@ impl Env {
             Named::Component(c, _) => Ref::Component(c),
             Named::Instance(s) => {
                 if seg.index.is_some() {
-                    return Err(not_indexed("a single instance"));
+                    return Err(not_indexed(seg, "a single instance"));
                 }
                 return self.enter_instance(s, rest, span);
             }
-            Named::Family(map) => {
-                if seg.index.is_none() && self.families {
-                    for m in map.values() {
-                        if let Member::Decl(d) = m {
-                            self.decls[*d].used = true;
-                        }
-                    }
-                    return Ok((Ref::Family(map.into_iter().collect()), rest.to_vec()));
-                }
-                let Some((i, ispan)) = seg.index else {
-                    let (lo, hi) = (
-                        map.keys().next().copied().unwrap_or(0),
-                        map.keys().last().copied().unwrap_or(0),
-                    );
+            Named::Family(map) => return self.follow_family(map, seg, rest, span),
+        };
+        Ok((r, rest.to_vec()))
+    }
+
+    /// A value binding; a reference argument (`hub: marker`) resolves what the caller wrote,
+    /// in the caller's scope, its offset collected for the marker.
+    fn follow_binding(
+        &mut self,
+        b: BindingId,
+        seg: &Seg,
+        rest: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
+        let name = &seg.name.name;
+        let is_ref = self.bindings[b]
+            .ty
+            .as_ref()
+            .map(|t| t.0.is_reference())
+            .unwrap_or(false);
+        if !is_ref {
+            return Ok((Ref::Binding(b), rest.to_vec()));
+        }
+        // A marker or body argument: resolve what the caller wrote, in the caller's scope.
+        self.bindings[b].used = true;
+        let (expr, bscope) = (self.bindings[b].expr.clone(), self.bindings[b].scope);
+        let Some(Expr {
+            kind: ExprKind::Path { path },
+            ..
+        }) = expr
+        else {
+            return Err(secondary(span));
+        };
+        if let Some(offset) = self.bindings[b].offset.clone() {
+            let shown = format!("{} @ ...", path.text());
+            if let Some(next) = rest.first() {
+                return Err(Diagnostic::error(
+                    Code::E0222,
+                    format!("`{name}` is the point `{shown}`: it has no `{}`", next.name.name),
+                )
+                .at(next.span, "after a point with an offset")
+                .hint("a marker passed with an offset (`@`) has no markers or quantities of its own: use it where a marker goes (a joint, a spring, a load), or pass the marker without the offset"));
+            }
+            match self.offsets.as_mut() {
+                Some(list) => list.push((offset, bscope)),
+                None => {
                     return Err(Diagnostic::error(
-                        Code::E0214,
-                        format!("`{name}` is an indexed family; say which one"),
+                        Code::E0222,
+                        format!("`{name}` is the point `{shown}`, usable only as a marker"),
                     )
-                    .at(seg.span, "no index")
-                    .hint(format!("write `{name}[i]` with i in {lo}..={hi}")));
-                };
-                match map.get(&i) {
-                    Some(Member::Decl(d)) => {
-                        self.decls[*d].used = true;
-                        Ref::Decl(*d)
-                    }
-                    Some(Member::Instance(s)) => return self.enter_instance(*s, rest, span),
-                    None => {
-                        let keys: Vec<i64> = map.keys().copied().collect();
-                        let range = match (keys.first(), keys.last()) {
-                            (Some(a), Some(b)) if (b - a + 1) as usize == keys.len() => {
-                                format!("{a}..={b}")
-                            }
-                            _ => keys
-                                .iter()
-                                .map(|k| k.to_string())
-                                .collect::<Vec<_>>()
-                                .join(", "),
-                        };
-                        return Err(Diagnostic::error(
-                            Code::E0214,
-                            format!("index {i} is out of range for `{name}`"),
-                        )
-                        .at(ispan, "no such member")
-                        .hint(format!("`{name}` has indices {range}")));
-                    }
+                    .at(span, "not used as a marker")
+                    .hint("a marker argument with an offset goes where a marker goes (a joint, a spring, a load); pass it without `@` to use it here"))
                 }
+            }
+        }
+        let mut segs = self.segs(bscope, &path)?;
+        segs.extend_from_slice(rest);
+        self.resolve(bscope, &segs, span)
+    }
+
+    /// An indexed family: a member, or the whole family where families are wanted.
+    fn follow_family(
+        &mut self,
+        map: BTreeMap<i64, Member>,
+        seg: &Seg,
+        rest: &[Seg],
+        span: Span,
+    ) -> Result<(Ref, Vec<Seg>), Diagnostic> {
+        let name = &seg.name.name;
+        if seg.index.is_none() && self.families {
+            for m in map.values() {
+                if let Member::Decl(d) = m {
+                    self.decls[*d].used = true;
+                }
+            }
+            return Ok((Ref::Family(map.into_iter().collect()), rest.to_vec()));
+        }
+        let Some((i, ispan)) = seg.index else {
+            let (lo, hi) = (
+                map.keys().next().copied().unwrap_or(0),
+                map.keys().last().copied().unwrap_or(0),
+            );
+            return Err(Diagnostic::error(
+                Code::E0214,
+                format!("`{name}` is an indexed family; say which one"),
+            )
+            .at(seg.span, "no index")
+            .hint(format!("write `{name}[i]` with i in {lo}..={hi}")));
+        };
+        let r = match map.get(&i) {
+            Some(Member::Decl(d)) => {
+                self.decls[*d].used = true;
+                Ref::Decl(*d)
+            }
+            Some(Member::Instance(s)) => return self.enter_instance(*s, rest, span),
+            None => {
+                let keys: Vec<i64> = map.keys().copied().collect();
+                let range = match (keys.first(), keys.last()) {
+                    (Some(a), Some(b)) if (b - a + 1) as usize == keys.len() => {
+                        format!("{a}..={b}")
+                    }
+                    _ => keys
+                        .iter()
+                        .map(|k| k.to_string())
+                        .collect::<Vec<_>>()
+                        .join(", "),
+                };
+                return Err(Diagnostic::error(
+                    Code::E0214,
+                    format!("index {i} is out of range for `{name}`"),
+                )
+                .at(ispan, "no such member")
+                .hint(format!("`{name}` has indices {range}")));
             }
         };
         Ok((r, rest.to_vec()))
@@ -332,4 +347,17 @@ impl Env {
             }
         }
     }
+}
+
+fn not_indexed(seg: &Seg, what: &str) -> Diagnostic {
+    let name = &seg.name.name;
+    Diagnostic::error(
+        Code::E0214,
+        format!("`{name}` is {what}, not an indexed family"),
+    )
+    .at(
+        seg.index.map(|i| i.1).unwrap_or(seg.span),
+        "index given here",
+    )
+    .hint(format!("write `{name}` without an index"))
 }

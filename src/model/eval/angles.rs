@@ -7,11 +7,14 @@
 //! and its expression names no angle anywhere: no `rad`, `deg` or `rev` in a unit (`rad/s`
 //! counts), no `pi`, no inverse trigonometric function, also through the params, lets,
 //! functions and arguments it names.
+//!
+//! Contract: reads expressions and the bindings they name; must not evaluate them (the caller
+//! gives the value).
 
-use super::env::{BindingKind, Env, Named, ScopeId};
-use super::types::ParamType;
 use super::units;
 use crate::diagnostics::{Code, Diagnostic};
+use crate::model::scope::env::{BindingKind, Env, Named, ScopeId};
+use crate::model::scope::types::ParamType;
 use crate::syntax::ast::{Expr, ExprKind, UnitExpr};
 
 /// Units that make a number an angle.
@@ -120,7 +123,7 @@ impl Env {
             _ => "give the angle a unit: multiply by `1 deg` for degrees, or by `1 rad` to say it is radians".to_string(),
         };
         Some(
-            Diagnostic::error(Code::W0203, format!("{what} has no angle unit{read}"))
+            Diagnostic::warning(Code::W0203, format!("{what} has no angle unit{read}"))
                 .at(e.span, "no `rad`, `deg` or `rev`")
                 .hint(hint),
         )

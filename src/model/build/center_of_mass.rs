@@ -2,13 +2,16 @@
 //! body and beam declared in it, recursively) or a family of them, each with the concentrated
 //! masses it carries. The runtime weighs each mass centre as its element's inertial forces do
 //! (a rigid body's `x + R eta`, a beam's section mass at the inertial quadrature points).
+//!
+//! Contract: resolves the call to bodies and beams and builds `Probe::CenterOfMass` channels; must
+//! not weigh the masses (the runtime does).
 
-use super::build::{Builder, Built};
-use super::env::{Member, Ref, ScopeId, Seg};
 use super::output_calls::segment;
-use super::outputs::AXES;
-use super::*;
+use super::probes::AXES;
+use super::{Builder, Built};
 use crate::diagnostics::{Code, Diagnostic};
+use crate::model::scope::env::{Member, Ref, ScopeId, Seg};
+use crate::model::*;
 use crate::syntax::ast::{OutputArg, OutputCall};
 
 /// What may follow `center_of_mass(...)`.

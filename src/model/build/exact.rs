@@ -6,12 +6,12 @@
 //! channel with it. Reports unknown channels (E0405), a second solution for one channel
 //! (E0406) and values that are not scalar functions of time (E0407).
 
-use super::build::Builder;
-use super::env::ScopeId;
-use super::eval::Value;
-use super::units::Dim;
-use super::*;
+use super::Builder;
 use crate::diagnostics::{did_you_mean, Code, Diagnostic};
+use crate::model::eval::units::Dim;
+use crate::model::eval::Value;
+use crate::model::scope::env::ScopeId;
+use crate::model::*;
 use crate::syntax::ast::{Item, Path};
 use std::collections::HashMap;
 
@@ -84,7 +84,7 @@ impl Builder<'_> {
                     )
                     .at(value.span, format!("this is {}", v.dim().describe()))
                     .at(column.span, "the channel is declared here")
-                    .hint(super::build::unit_hint(dim.into(), false));
+                    .hint(super::unit_hint(dim.into(), false));
                     self.error(scope, d);
                     continue;
                 }

@@ -1,0 +1,344 @@
+//! Sections: the 6x6 stiffness (whole or its diagonal, with per-block units), the mass per
+//! length, its offset and inertias, checked positive; declared (`section NAME { ... }`),
+//! written in a beam, or named by one. Contract: builds `Section`s; must not build beams.
+
+use super::{Builder, Built, View};
+use crate::diagnostics::{Code, Diagnostic};
+use crate::model::eval::units::{self, Dim, Quantity};
+use crate::model::eval::Value;
+use crate::model::scope::env::Ref;
+use crate::model::*;
+use crate::syntax::ast::{Block, Prop, PropValue};
+use std::collections::HashMap;
+
+const BENDING: Quantity = Dim::new(1, 3, -2).quantity();
+
+type Props = HashMap<&'static str, Prop>;
+
+impl Builder<'_> {
+    pub(super) fn section_decl(&mut self, v: &View) -> Option<Built> {
+        if !self.shape(
+            v,
+            0,
+            false,
+            false,
+            &[],
+            "section NAME { EA = ..., EI2 = ..., mass_per_length = ... }",
+        ) {
+            return None;
+        }
+        let block = v.block.clone().unwrap_or_default();
+        let s = self.section(v, &block, v.name.clone())?;
+        self.sections.push(s);
+        Some(Built::Section(self.sections.len() - 1))
+    }
+
+    pub(super) fn section(&mut self, v: &View, block: &Block, name: String) -> Option<Section> {
+        let p = self.props(
+            v.scope,
+            Some(block),
+            &[
+                "EA",
+                "GA2",
+                "GA3",
+                "GJ",
+                "EI2",
+                "EI3",
+                "stiffness",
+                "mass_per_length",
+                "mass_offset2",
+                "mass_offset3",
+                "i2",
+                "i3",
+                "polar",
+            ],
+            "a section",
+        );
+        let (k, ok) = self.section_stiffness(v, block, &p)?;
+        let mass = self.section_mass(v, block, &p);
+        if !ok {
+            return None;
+        }
+        let (mass, mass_offset, inertia) = mass?;
+        let section = Section {
+            name,
+            stiffness: k,
+            mass_per_length: mass,
+            mass_offset,
+            inertia,
+        };
+        self.check_section(v, block, &p, &section)
+            .then_some(section)
+    }
+
+    /// The 6x6 stiffness, written whole or as its diagonal; `None` to stop at once, and
+    /// whether every diagonal entry was given.
+    fn section_stiffness(
+        &mut self,
+        v: &View,
+        block: &Block,
+        p: &Props,
+    ) -> Option<([[f64; 6]; 6], bool)> {
+        const DIAG: [(&str, Quantity); 6] = [
+            ("EA", units::AXIAL_STIFFNESS),
+            ("GA2", units::SHEAR_STIFFNESS),
+            ("GA3", units::SHEAR_STIFFNESS),
+            ("GJ", units::TORSIONAL_RIGIDITY),
+            ("EI2", BENDING),
+            ("EI3", BENDING),
+        ];
+        let mut k = [[0.0; 6]; 6];
+        let mut ok = true;
+        if let Some(sp) = p.get("stiffness") {
+            if let Some((name, _)) = DIAG.iter().find(|(n, _)| p.contains_key(n)) {
+                self.error(
+                    v.scope,
+                    Diagnostic::error(Code::E0224, "a section gives either `stiffness` (6x6) or the diagonal stiffnesses, not both")
+                        .at(p.get(name).map(|q| q.name.span).unwrap_or(sp.name.span), "diagonal stiffness")
+                        .at(sp.name.span, "full matrix")
+                        .hint("keep one of them"),
+                );
+                return None;
+            }
+            k = self.matrix6(v, sp)?;
+        } else {
+            for (i, (key, dim)) in DIAG.iter().enumerate() {
+                let example = if i < 3 { "8.53e7 N" } else { "1.28e4 N*m^2" };
+                match self
+                    .required(v.scope, p, key, block.span, "a section", example)
+                    .and_then(|e| self.scalar(v.scope, e, *dim, &format!("`{key}`")))
+                {
+                    Some(x) => k[i][i] = x,
+                    None => ok = false,
+                }
+            }
+        }
+        Some((k, ok))
+    }
+
+    /// The mass per length, its offset (axes 2, 3) and the inertias (polar, 2, 3).
+    #[allow(clippy::type_complexity)]
+    fn section_mass(
+        &mut self,
+        v: &View,
+        block: &Block,
+        p: &Props,
+    ) -> Option<(f64, [f64; 2], [f64; 3])> {
+        let mass = self
+            .required(
+                v.scope,
+                p,
+                "mass_per_length",
+                block.span,
+                "a section",
+                "3.29 kg/m",
+            )
+            .and_then(|e| self.scalar(v.scope, e, Dim::new(1, -1, 0), "`mass_per_length`"));
+        let get = |this: &mut Self, key: &str, dim: Dim| match this.expr(v.scope, p.get(key)) {
+            Some(e) => this.scalar(v.scope, e, dim, &format!("`{key}`")),
+            None => Some(0.0),
+        };
+        let o2 = get(self, "mass_offset2", Dim::LENGTH);
+        let o3 = get(self, "mass_offset3", Dim::LENGTH);
+        let i2 = get(self, "i2", Dim::new(1, 1, 0));
+        let i3 = get(self, "i3", Dim::new(1, 1, 0));
+        let polar = match self.expr(v.scope, p.get("polar")) {
+            Some(e) => self.scalar(v.scope, e, Dim::new(1, 1, 0), "`polar`"),
+            None => match (i2, i3) {
+                (Some(a), Some(b)) => Some(a + b),
+                _ => None,
+            },
+        };
+        let (mass, o2, o3, i2, i3, polar) = (mass?, o2?, o3?, i2?, i3?, polar?);
+        Some((mass, [o2, o3], [polar, i2, i3]))
+    }
+
+    /// A positive mass, non-negative inertias and a symmetric positive definite stiffness.
+    fn check_section(&mut self, v: &View, block: &Block, p: &Props, s: &Section) -> bool {
+        let (name, mass, k) = (&s.name, s.mass_per_length, &s.stiffness);
+        let [polar, i2, i3] = s.inertia;
+        if mass <= 0.0 {
+            self.error(
+                v.scope,
+                Diagnostic::error(
+                    Code::E0302,
+                    format!("section `{name}` has a non-positive mass per length"),
+                )
+                .at(
+                    p.get("mass_per_length")
+                        .map(|q| q.span())
+                        .unwrap_or(block.span),
+                    format!("{mass} kg/m"),
+                )
+                .hint("a beam needs mass; a massless beam makes the iteration matrix singular"),
+            );
+            return false;
+        }
+        if i2 < 0.0 || i3 < 0.0 || polar < 0.0 {
+            self.error(
+                v.scope,
+                Diagnostic::error(
+                    Code::E0311,
+                    format!("section `{name}` has a negative mass moment of inertia"),
+                )
+                .at(block.span, "in this section")
+                .hint("i2, i3 and polar are non-negative (kg*m)"),
+            );
+            return false;
+        }
+        let m = nalgebra::Matrix6::from_fn(|i, j| k[i][j]);
+        let sym = (0..6).all(|i| {
+            (0..6).all(|j| (k[i][j] - k[j][i]).abs() <= 1e-9 * (k[i][i].abs() + k[j][j].abs()))
+        });
+        if !sym || m.cholesky().is_none() {
+            self.error(
+                v.scope,
+                Diagnostic::error(Code::E0311, format!("the stiffness of section `{name}` is not symmetric positive definite"))
+                    .at(block.span, "in this section")
+                    .hint("every stiffness must be positive (a beam stiff in some direction still needs a finite value), and couplings must leave the matrix positive definite"),
+            );
+            return false;
+        }
+        true
+    }
+
+    /// `stiffness = ((k11, ..., k16), ..., (k61, ..., k66))` with per-block units.
+    fn matrix6(&mut self, v: &View, p: &crate::syntax::ast::Prop) -> Option<[[f64; 6]; 6]> {
+        use crate::syntax::ast::ExprKind;
+        let bad = |this: &mut Self, span: Span| {
+            this.error(
+                v.scope,
+                Diagnostic::error(Code::E0209, "`stiffness` must be a 6x6 matrix")
+                    .at(span, "not six rows of six")
+                    .hint("write `stiffness = ((EA, 0, 0, 0, 0, 0) N, ..., (0, 0, 0, 0, 0, EI3) N*m^2)`; rows and columns 1-3 in N, 4-6 in N*m, the lower-right block in N*m^2"),
+            );
+            None
+        };
+        let PropValue::Expr(e) = &p.value else {
+            return bad(self, p.name.span);
+        };
+        let ExprKind::Vector {
+            items: rows,
+            unit: None,
+        } = &e.kind
+        else {
+            return bad(self, e.span);
+        };
+        if rows.len() != 6 {
+            return bad(self, e.span);
+        }
+        let mut k = [[0.0; 6]; 6];
+        for (i, row) in rows.iter().enumerate() {
+            let ExprKind::Vector { items, unit } = &row.kind else {
+                return bad(self, row.span);
+            };
+            if items.len() != 6 {
+                return bad(self, row.span);
+            }
+            for (j, item) in items.iter().enumerate() {
+                let dim = Dim::new(1, 1 + (i >= 3) as i8 + (j >= 3) as i8, -2);
+                // A row may carry one unit after its parenthesis: apply it to every entry.
+                let val = self.value(v.scope, item)?;
+                let (x, d) = match (val, unit) {
+                    (Value::Scalar { value, dim: d }, Some(u)) => {
+                        let wrapped = crate::syntax::ast::Expr {
+                            kind: ExprKind::Quantity {
+                                value: 1.0,
+                                unit: Some(u.clone()),
+                            },
+                            span: u.span,
+                        };
+                        let f = self.value(v.scope, &wrapped)?;
+                        (value * scalar_of(&f), d.times(f.dim()))
+                    }
+                    (Value::Scalar { value, dim: d }, None) => (value, d),
+                    (other, _) => {
+                        self.error(
+                            v.scope,
+                            Diagnostic::error(
+                                Code::E0209,
+                                format!(
+                                    "a stiffness entry must be a constant scalar, found {}",
+                                    other.kind_name()
+                                ),
+                            )
+                            .at(item.span, "here")
+                            .hint("write numbers with units"),
+                        );
+                        return None;
+                    }
+                };
+                if x != 0.0 && d != dim {
+                    self.error(
+                        v.scope,
+                        Diagnostic::error(Code::E0202, format!("stiffness entry ({}, {}) must be {}, found {}", i + 1, j + 1, dim.describe(), d.describe()))
+                            .at(item.span, format!("this is {}", d.describe()))
+                            .hint("rows and columns 1-3 are forces (N), 4-6 moments (N*m): the blocks are N, N*m and N*m^2"),
+                    );
+                    return None;
+                }
+                k[i][j] = x;
+            }
+        }
+        Some(k)
+    }
+
+    pub(super) fn section_ref(
+        &mut self,
+        v: &View,
+        e: &crate::syntax::ast::Expr,
+    ) -> Option<Section> {
+        use crate::syntax::ast::ExprKind;
+        let ExprKind::Path { path } = &e.kind else {
+            self.error(
+                v.scope,
+                Diagnostic::error(Code::E0222, "`section` names a section")
+                    .at(e.span, "not a name")
+                    .hint("write `section = NAME` or `section = { EA = ..., ... }`"),
+            );
+            return None;
+        };
+        let r = self
+            .env
+            .segs(v.scope, path)
+            .and_then(|s| self.env.resolve(v.scope, &s, path.span));
+        match r {
+            Ok((Ref::Decl(d), rest)) if rest.is_empty() => match self.built[d] {
+                Some(Built::Section(i)) => Some(self.sections[i].clone()),
+                None if self.env.decls[d].item_kind() == Some("section") => None,
+                _ => {
+                    self.error(
+                        v.scope,
+                        Diagnostic::error(
+                            Code::E0222,
+                            format!("`{}` is not a section", self.env.decls[d].name),
+                        )
+                        .at(e.span, "not a section")
+                        .hint("declare one with `section NAME { ... }`"),
+                    );
+                    None
+                }
+            },
+            Ok(_) => {
+                self.error(
+                    v.scope,
+                    Diagnostic::error(Code::E0222, "`section` names a section")
+                        .at(e.span, "not a section")
+                        .hint("declare one with `section NAME { ... }`"),
+                );
+                None
+            }
+            Err(d) => {
+                self.error(v.scope, d);
+                None
+            }
+        }
+    }
+}
+
+fn scalar_of(v: &Value) -> f64 {
+    match v {
+        Value::Scalar { value, .. } => *value,
+        _ => 1.0,
+    }
+}
