@@ -10,9 +10,6 @@ pub mod floquet;
 mod integrator;
 pub mod linear;
 pub mod modes;
-mod newton;
-mod rotations;
-mod se3;
 mod steady;
 
 pub use crate::settings::{Method, Rotations, Settings, Start};

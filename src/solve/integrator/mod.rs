@@ -13,6 +13,9 @@
 mod fet;
 mod linearize;
 mod newmark;
+mod newton;
+mod rotations;
+mod se3;
 mod start;
 mod start_matrix;
 mod statics;
@@ -20,12 +23,12 @@ mod statics;
 pub use linearize::Linearization;
 
 use super::linear::{LinearError, SparseLu};
-use super::newton::Newton;
-use super::rotations::Transform;
 use super::{FailureKind, Method, Rotations, RunStats, RuntimeFailure, Settings};
 use crate::runtime::rotation::{M3, V3};
 use crate::runtime::{Assembler, Augment, Residual, State, System};
 use newmark::Scheme;
+use newton::Newton;
+use rotations::Transform;
 use start_matrix::StartMetric;
 
 /// Largest rotation of a node in one Newton correction (rad).
@@ -35,10 +38,10 @@ const MAX_TURN: f64 = 0.5;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Layout {
     /// Stored rotations moved by body-frame increments: rigid bodies as SE(3) frames, beam
-    /// nodes as SO(3) x R3 ([`super::se3`]); the Newmark family with `Rotations::Incremental`.
+    /// nodes as SO(3) x R3 ([`se3`]); the Newmark family with `Rotations::Incremental`.
     Increments,
     /// The total conformal rotation vector as the unknown, with its rates
-    /// ([`super::rotations`]); the Newmark family with `Rotations::Conformal`.
+    /// ([`rotations`]); the Newmark family with `Rotations::Conformal`.
     Conformal,
     /// Virtual rotations, the state in the physical layout: time finite elements.
     Physical,

@@ -13,14 +13,15 @@
 //! from `rho_inf` (THEORY §7.5).
 //!
 //! Rotations: with the incremental treatment each rotating node is an SE(3) frame updated by
-//! body-frame increments ([`crate::solve::se3`]); with the conformal treatment the rotation
-//! unknowns hold `c`, `c-dot`, `c-ddot` like any coordinate ([`crate::solve::rotations`]).
+//! body-frame increments ([`super::se3`]); with the conformal treatment the rotation
+//! unknowns hold `c`, `c-dot`, `c-ddot` like any coordinate ([`super::rotations`]).
 
+use super::{rotations, se3};
 use super::{Integrator, Layout, Norms, StepFailure};
 use crate::runtime::rotation::{self as rot};
 use crate::runtime::{Augment, TangentCoeffs, UnknownKind};
 use crate::settings::{Method, Settings};
-use crate::solve::{rotations, se3, FailureKind};
+use crate::solve::FailureKind;
 
 /// The scheme's constants.
 #[derive(Clone, Copy, Debug)]

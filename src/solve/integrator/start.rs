@@ -4,11 +4,12 @@
 //! state leaves in the layout of the integrator's rotation treatment.
 
 use super::start_matrix::StartMetric;
+use super::{rotations, se3};
 use super::{Integrator, Layout, StepFailure};
 use crate::runtime::rotation::{self as rot, V3};
 use crate::runtime::{Rate, State, UnknownKind};
 use crate::settings::{Method, Start};
-use crate::solve::{rotations, se3, FailureKind, Notice, NoticeKind, RunStats, RuntimeFailure};
+use crate::solve::{FailureKind, Notice, NoticeKind, RunStats, RuntimeFailure};
 
 impl Integrator<'_> {
     /// Solves `[M, s B^T; s B, 0] x = rhs` at `trial` (the constrained mass matrix, in the

@@ -4,9 +4,9 @@
 //! what is its own is here: the rates it zeroes and the iteration matrix's coefficients
 //! (stiffness only). A failing load step is split up to 1/16 (`settings::STATIC_HALVINGS`).
 
+use super::rotations;
 use super::{Integrator, Layout};
 use crate::runtime::TangentCoeffs;
-use crate::solve::rotations;
 
 impl Integrator<'_> {
     /// The iterate's rates: zero (multipliers are kept).
