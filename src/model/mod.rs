@@ -6,8 +6,8 @@
 //!
 //! Its steps live in folders: `scope/` (names, scopes, elaboration, resolution), `eval/`
 //! (values, units, expressions and built-in functions), `build/` (entities from declarations,
-//! outputs), `check/` (topology and the numbering of the unknowns); `settings.rs` reads the
-//! `solve` block. This file holds the stage's public types.
+//! outputs and the `solve` block, recorded as written), `check/` (topology and the numbering
+//! of the unknowns). This file holds the stage's public types.
 
 mod build;
 mod check;
