@@ -29,9 +29,10 @@
 use super::integrator::{Integrator, Linearization};
 use super::linear::{generalized_eigen, null_space};
 use super::modes::c64;
-use super::{RuntimeFailure, Settings, Stop};
+use super::{RuntimeFailure, Stop};
 use crate::runtime::rotation::{exp, log, V3};
 use crate::runtime::{State, System, UnknownKind};
+use crate::settings::Settings;
 use nalgebra::DMatrix;
 use std::convert::Infallible;
 

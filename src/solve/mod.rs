@@ -1,5 +1,6 @@
-//! Solve: System -> trajectory. Newton, HHT-alpha, generalized-alpha and time finite elements,
-//! sparse LU reuse.
+//! Solve: System -> trajectory, with the [`crate::settings::Settings`] of the run: the
+//! integrators ([`Integrator`]: HHT-alpha, generalized-alpha, statics, time finite elements on
+//! one Newton loop and one sparse LU), modes about a steady motion, Floquet analysis.
 //!
 //! Contract: drives the runtime through its generic interface (residual parts, tangent with
 //! coefficients, constraint rates, rotating nodes); knows no concrete element type and no
@@ -12,7 +13,6 @@ pub mod linear;
 pub mod modes;
 mod steady;
 
-pub use crate::settings::{Method, Rotations, Settings, Start};
 pub use integrator::{Integrator, Linearization, Stop};
 
 use serde::Serialize;

@@ -22,9 +22,10 @@ use super::linear::{generalized_eigen, null_space};
 use super::steady::{
     coordinates, periodic_change, relax, rigid_motion, uniform_spin, PERIODIC_TOL,
 };
-use super::{RuntimeFailure, Settings};
+use super::RuntimeFailure;
 use crate::runtime::rotation::{tilde, V3};
 use crate::runtime::System;
+use crate::settings::Settings;
 use nalgebra::DMatrix;
 
 /// A complex number `re + i im`.

@@ -23,9 +23,10 @@ mod statics;
 pub use linearize::Linearization;
 
 use super::linear::{LinearError, SparseLu};
-use super::{FailureKind, Method, Rotations, RunStats, RuntimeFailure, Settings};
+use super::{FailureKind, RunStats, RuntimeFailure};
 use crate::runtime::rotation::{M3, V3};
 use crate::runtime::{Assembler, Augment, Residual, State, System};
+use crate::settings::{Method, Rotations, Settings};
 use newmark::Scheme;
 use newton::Newton;
 use rotations::Transform;

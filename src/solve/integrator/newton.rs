@@ -1,8 +1,8 @@
 //! Newton's bookkeeping within one step, shared by the integrators: tolerances, the
 //! convergence test and the divergence test (THEORY §7.3).
 
-use super::Settings;
 use crate::runtime::System;
+use crate::settings::Settings;
 
 /// Newton's bookkeeping within one step, shared by the integrators (THEORY §7.3).
 pub(super) struct Newton {
