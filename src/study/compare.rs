@@ -9,6 +9,45 @@
 //! time (within `1e-9 dt`), else from cubic (4-point Lagrange) interpolation.
 
 use crate::runtime::timefn::TimeFn;
+use std::fmt;
+
+/// A table that gives no samples of a channel (a reference file). `Display` is the message.
+#[derive(Clone, Debug, PartialEq)]
+pub enum SamplesError {
+    /// No `t` (or `time`) column.
+    NoTime,
+    /// No column of the channel; `columns` are the others but time.
+    NoColumn {
+        channel: String,
+        columns: Vec<String>,
+    },
+    /// The time of this row (1-based, after the header) is not a number.
+    TimeNotANumber { row: usize },
+    /// The time of this row is not after the previous row's.
+    NotIncreasing { row: usize, t: f64, after: f64 },
+}
+
+impl fmt::Display for SamplesError {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self {
+            SamplesError::NoTime => write!(f, "the CSV has no `t` (or `time`) column"),
+            SamplesError::NoColumn { channel, columns } => write!(
+                f,
+                "no column `{channel}`; its columns are: {}",
+                columns.join(", ")
+            ),
+            SamplesError::TimeNotANumber { row } => {
+                write!(f, "row {row} has a time that is not a number")
+            }
+            SamplesError::NotIncreasing { row, t, after } => write!(
+                f,
+                "the times do not increase at row {row} (t = {t} after {after})"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for SamplesError {}
 
 /// One channel against time, times increasing.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -23,23 +62,23 @@ impl Samples {
         header: &[String],
         rows: &[Vec<f64>],
         channel: &str,
-    ) -> Result<Samples, String> {
+    ) -> Result<Samples, SamplesError> {
         let time = header
             .iter()
             .position(|h| h == "t")
             .or_else(|| header.iter().position(|h| h == "time"))
-            .ok_or("the CSV has no `t` (or `time`) column")?;
+            .ok_or(SamplesError::NoTime)?;
         let Some(k) = header.iter().position(|h| h == channel) else {
-            let known: Vec<&str> = header
+            let columns: Vec<String> = header
                 .iter()
                 .enumerate()
                 .filter(|(i, _)| *i != time)
-                .map(|(_, h)| h.as_str())
+                .map(|(_, h)| h.clone())
                 .collect();
-            return Err(format!(
-                "no column `{channel}`; its columns are: {}",
-                known.join(", ")
-            ));
+            return Err(SamplesError::NoColumn {
+                channel: channel.to_string(),
+                columns,
+            });
         };
         Ok(Samples {
             t: rows.iter().map(|r| r[time]).collect(),
@@ -48,17 +87,16 @@ impl Samples {
     }
 
     /// An error unless the times are finite and strictly increasing.
-    pub fn check_increasing(&self) -> Result<(), String> {
+    pub fn check_increasing(&self) -> Result<(), SamplesError> {
         if let Some(k) = self.t.iter().position(|t| !t.is_finite()) {
-            return Err(format!("row {} has a time that is not a number", k + 1));
+            return Err(SamplesError::TimeNotANumber { row: k + 1 });
         }
         match self.t.windows(2).position(|w| w[1] <= w[0]) {
-            Some(k) => Err(format!(
-                "the times do not increase at row {} (t = {} after {})",
-                k + 2,
-                self.t[k + 1],
-                self.t[k]
-            )),
+            Some(k) => Err(SamplesError::NotIncreasing {
+                row: k + 2,
+                t: self.t[k + 1],
+                after: self.t[k],
+            }),
             None => Ok(()),
         }
     }

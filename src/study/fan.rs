@@ -9,9 +9,10 @@
 //! its mode where frequencies cross. Must not read or write files.
 
 use super::parallel;
-use super::sweep::{CompileWith, Tick};
+use super::sweep::{CompileWith, PointError, Tick};
 use crate::output::charts::{Chart, Series};
 use crate::solve::modes::{c64, Mode};
+use std::fmt::Display;
 use std::io::{self, Write};
 
 /// What to sweep.
@@ -35,7 +36,7 @@ pub struct FanPoint {
     pub frame: &'static str,
     /// The fastest spin of any node at the start (rad/s): the rotor speed of the per-rev lines.
     pub rotor_speed: f64,
-    pub failure: Option<String>,
+    pub failure: Option<PointError>,
 }
 
 #[derive(Clone, Debug)]
@@ -65,13 +66,17 @@ fn mac(a: &[c64], b: &[c64]) -> f64 {
 }
 
 /// Runs the sweep (points in parallel) and follows the modes across it.
-pub fn fan(spec: &FanSpec, compile: &CompileWith, tick: &(dyn Fn(Tick) + Sync)) -> Fan {
+pub fn fan<E: Display>(
+    spec: &FanSpec,
+    compile: &CompileWith<E>,
+    tick: &(dyn Fn(Tick) + Sync),
+) -> Fan {
     tick(Tick::Planned(spec.values.len()));
     let raw = parallel(spec.values.len(), |k| {
         let value = spec.values[k];
-        let result = compile(&[format!("{}={value}", spec.param)]).and_then(|c| {
-            crate::modes(&c, spec.frozen).map_err(|d| format!("{} {}", d.code.as_str(), d.message))
-        });
+        let result = compile(&[format!("{}={value}", spec.param)])
+            .map_err(|e| PointError::Compile(e.to_string()))
+            .and_then(|c| crate::modes(&c, spec.frozen).map_err(|d| PointError::diagnostic(&d)));
         let summary = match &result {
             Ok(m) => format!(
                 "{} = {value}: {} modes, lowest {:.6} rad/s",
@@ -89,9 +94,7 @@ pub fn fan(spec: &FanSpec, compile: &CompileWith, tick: &(dyn Fn(Tick) + Sync)) 
     let mut last: Vec<Vec<c64>> = Vec::new();
     for (k, r) in raw.into_iter().enumerate() {
         let value = spec.values[k];
-        let r = r.unwrap_or_else(|| {
-            Err("the evaluation stopped on an internal error (a bug in mbd)".into())
-        });
+        let r = r.unwrap_or(Err(PointError::Internal));
         let m = match r {
             Ok(m) => m,
             Err(e) => {

@@ -10,155 +10,25 @@
 //! `use`d modules), any reference file's samples, and the writers for the CSV and the chart.
 
 pub mod compare;
+mod compile_error;
 pub mod convergence;
 pub mod fan;
+mod items;
 pub mod prony;
 pub mod stability;
 pub mod sweep;
 
-use crate::settings::{self, Method, Request};
+pub use compile_error::CompileError;
+pub use items::{parse_alphas, split_list, IntegratorItem, StepList, UsageError};
+
+use crate::settings::Request;
 use crate::Compiled;
 use compare::Samples;
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Compiles the model with the given overrides (the `--set` params are the caller's); the
-/// error is a one-line message. Called from worker threads.
-pub type Compile<'a> = dyn Fn(&Request) -> Result<Compiled, String> + Sync + 'a;
-
-/// One item of `--integrator LIST`, kept as written for the CSV.
-#[derive(Clone, Debug, PartialEq)]
-pub struct IntegratorItem {
-    /// As written: `hht`, `hht:-0.3`, `generalized-alpha:0.5`, `fet`.
-    pub text: String,
-    pub integrator: Method,
-    /// HHT alpha (`hht:ALPHA`), in [-1/3, 0]; `None`: the model's.
-    pub alpha: Option<f64>,
-    /// Generalized-alpha spectral radius at infinity (`generalized-alpha:RHO`), in [0, 1].
-    pub rho_inf: Option<f64>,
-}
-
-impl IntegratorItem {
-    /// Parses `hht`, `hht:ALPHA`, `generalized-alpha`, `generalized-alpha:RHO_INF` or `fet`.
-    pub fn parse(text: &str) -> Result<IntegratorItem, String> {
-        let text = text.trim();
-        let (name, arg) = match text.split_once(':') {
-            Some((n, a)) => (n, Some(a)),
-            None => (text, None),
-        };
-        let item = |integrator, alpha, rho_inf| IntegratorItem {
-            text: text.to_string(),
-            integrator,
-            alpha,
-            rho_inf,
-        };
-        match (name, arg) {
-            ("hht", a) => {
-                let alpha = a
-                    .map(|a| bounded(text, "alpha", a, settings::ALPHA))
-                    .transpose()?;
-                Ok(item(Method::Hht, alpha, None))
-            }
-            ("generalized-alpha" | "generalized_alpha", a) => {
-                let rho = a
-                    .map(|a| bounded(text, "rho_inf", a, settings::RHO_INF))
-                    .transpose()?;
-                Ok(item(Method::GeneralizedAlpha, None, rho))
-            }
-            ("fet", None) => Ok(item(Method::Fet, None, None)),
-            ("fet", Some(_)) => Err(format!("`{text}`: fet takes no parameter")),
-            _ => Err(format!(
-                "unknown integrator `{text}`; the items are hht, hht:ALPHA (e.g. hht:-0.3), generalized-alpha, generalized-alpha:RHO_INF (e.g. generalized-alpha:0.5) and fet"
-            )),
-        }
-    }
-
-    /// `base` with this integrator setting.
-    pub fn request(&self, base: &Request) -> Request {
-        let mut o = base.clone();
-        o.method = Some(self.integrator);
-        o.alpha = self.alpha.or(base.alpha);
-        o.rho_inf = self.rho_inf.or(base.rho_inf);
-        o
-    }
-}
-
-fn bounded(item: &str, what: &str, text: &str, range: settings::Range) -> Result<f64, String> {
-    let v: f64 = text
-        .trim()
-        .parse()
-        .map_err(|_| format!("`{item}`: {what} `{text}` is not a number"))?;
-    if !range.contains(v) {
-        return Err(format!("`{item}`: {what} = {v} is outside {}", range.text));
-    }
-    Ok(v)
-}
-
-/// The items of a comma-separated list (`--steps 100,200`); an empty list or item is an error.
-pub fn split_list<'t>(text: &'t str, flag: &str) -> Result<Vec<&'t str>, String> {
-    let items: Vec<&str> = text.split(',').map(str::trim).collect();
-    if items.iter().any(|i| i.is_empty()) {
-        return Err(format!(
-            "{flag} takes a comma-separated list without empty items, got `{text}`"
-        ));
-    }
-    Ok(items)
-}
-
-/// The runs' steps: `--steps LIST` (counts; dt = until / N) or `--dt LIST` (seconds;
-/// N = round(until / dt)). Either way every run ends at the model's end time.
-#[derive(Clone, Debug, PartialEq)]
-pub enum StepList {
-    Counts(Vec<usize>),
-    Dt(Vec<f64>),
-}
-
-impl StepList {
-    pub fn parse_counts(text: &str) -> Result<StepList, String> {
-        let mut out = Vec::new();
-        for s in split_list(text, "--steps")? {
-            match s.parse::<usize>() {
-                Ok(n) if n >= 1 => out.push(n),
-                _ => {
-                    return Err(format!(
-                        "--steps: `{s}` is not a whole number of steps of at least 1"
-                    ))
-                }
-            }
-        }
-        Ok(StepList::Counts(out))
-    }
-
-    pub fn parse_dt(text: &str) -> Result<StepList, String> {
-        let mut out = Vec::new();
-        for s in split_list(text, "--dt")? {
-            match s.parse::<f64>() {
-                Ok(d) if d > 0.0 && d.is_finite() => out.push(d),
-                _ => return Err(format!("--dt: `{s}` is not a positive number of seconds")),
-            }
-        }
-        Ok(StepList::Dt(out))
-    }
-
-    /// Step counts for a run that ends at `until`.
-    pub fn counts(&self, until: f64) -> Result<Vec<usize>, String> {
-        match self {
-            StepList::Counts(n) => Ok(n.clone()),
-            StepList::Dt(dts) => dts
-                .iter()
-                .map(|&dt| {
-                    let n = (until / dt).round();
-                    if (1.0..=1e9).contains(&n) {
-                        Ok(n as usize)
-                    } else {
-                        Err(format!(
-                            "--dt {dt} s does not fit the run's {until} s (round(until / dt) = {n})"
-                        ))
-                    }
-                })
-                .collect(),
-        }
-    }
-}
+/// Compiles the model with the given overrides (the `--set` params are the caller's). Called
+/// from worker threads.
+pub type Compile<'a> = dyn Fn(&Request) -> Result<Compiled, CompileError> + Sync + 'a;
 
 /// Why a run gave no usable result: the failure's one-line message (`E0601 Newton iteration
 /// failed at t = ...`), and the time it happened when known.
@@ -197,7 +67,7 @@ pub fn measure(compile: &Compile, overrides: &Request, channel: &str) -> Measure
     o.every = Some(1);
     let c = match compile(&o) {
         Ok(c) => c,
-        Err(e) => return Measured::failed(e),
+        Err(e) => return Measured::failed(e.to_string()),
     };
     let mut out: Vec<u8> = Vec::new();
     let start = thread_cpu_seconds();
@@ -318,40 +188,6 @@ fn cell(x: Option<f64>) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn integrator_items_parse_as_written() {
-        let hht = IntegratorItem::parse("hht:-0.3").unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!((hht.integrator, hht.alpha), (Method::Hht, Some(-0.3)));
-        assert_eq!(hht.text, "hht:-0.3");
-        let ga = IntegratorItem::parse("generalized-alpha:0.5").unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(
-            (ga.integrator, ga.rho_inf),
-            (Method::GeneralizedAlpha, Some(0.5))
-        );
-        assert!(IntegratorItem::parse("fet").is_ok());
-        for bad in [
-            "hht:0.5",
-            "hht:x",
-            "rk4",
-            "generalized-alpha:2",
-            "fet:1",
-            "",
-        ] {
-            assert!(IntegratorItem::parse(bad).is_err(), "{bad}");
-        }
-    }
-
-    #[test]
-    fn step_lists_keep_the_end_time() {
-        let dt = StepList::parse_dt("0.1,0.05").unwrap_or_else(|e| panic!("{e}"));
-        assert_eq!(dt.counts(1.0), Ok(vec![10, 20]));
-        assert!(StepList::parse_dt("0.1,,0.05").is_err());
-        assert!(StepList::parse_counts("0").is_err());
-        assert!(StepList::parse_dt("5")
-            .map(|d| d.counts(1.0).is_err())
-            .unwrap_or(false));
-    }
 
     #[test]
     fn parallel_returns_every_job_in_order() {

@@ -16,6 +16,7 @@
 use crate::solve::linear::{generalized_eigen, least_squares, svd_right};
 use crate::solve::modes::c64;
 use nalgebra::DMatrix;
+use std::fmt;
 
 /// Settings of the fit.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -56,6 +57,39 @@ pub struct Pole {
     pub amplitude: f64,
 }
 
+/// Why the matrix pencil found no poles. `Display` is the message.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PencilError {
+    /// Fewer than 12 samples of a signal that is not zero throughout.
+    TooFewSamples {
+        samples: usize,
+    },
+    SvdFailed,
+    /// Every singular value is zero (or NaN).
+    NoEnergy,
+    PencilFailed,
+    EigenvaluesFailed,
+    AmplitudeFitFailed,
+}
+
+impl fmt::Display for PencilError {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self {
+            PencilError::TooFewSamples { samples } => write!(
+                f,
+                "a transient fit needs at least 12 samples of a signal that is not zero throughout, got {samples}"
+            ),
+            PencilError::SvdFailed => write!(f, "the singular value decomposition failed"),
+            PencilError::NoEnergy => write!(f, "the signals carry no energy"),
+            PencilError::PencilFailed => write!(f, "the pencil could not be formed"),
+            PencilError::EigenvaluesFailed => write!(f, "the pencil's eigenvalues failed"),
+            PencilError::AmplitudeFitFailed => write!(f, "the amplitude fit failed"),
+        }
+    }
+}
+
+impl std::error::Error for PencilError {}
+
 /// The minimum-norm least-squares solution of `a x = b` (SVD, singular values below 1e-12 of
 /// the largest dropped).
 fn solve_ls(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Option<DMatrix<f64>> {
@@ -68,17 +102,17 @@ fn solve_ls(a: &DMatrix<f64>, b: &DMatrix<f64>) -> Option<DMatrix<f64>> {
 
 /// The pencil's eigenvalues `z` at order `m`, from the right singular vectors `vs` (columns
 /// of length `width`, leading first): `V1 A = V2` in least squares.
-fn pencil_poles(vs: &[f64], width: usize, m: usize) -> Result<Vec<c64>, String> {
+fn pencil_poles(vs: &[f64], width: usize, m: usize) -> Result<Vec<c64>, PencilError> {
     let l = width - 1;
     let v = DMatrix::<f64>::from_fn(width, m, |i, j| vs[j * width + i]);
     let v1 = v.rows(0, l).into_owned();
     let v2 = v.rows(1, l).into_owned();
-    let a = solve_ls(&v1, &v2).ok_or("the pencil could not be formed")?;
+    let a = solve_ls(&v1, &v2).ok_or(PencilError::PencilFailed)?;
     let col: Vec<f64> = (0..m * m).map(|p| a[(p % m, p / m)]).collect();
     let identity: Vec<f64> = (0..m * m)
         .map(|p| if p % (m + 1) == 0 { 1.0 } else { 0.0 })
         .collect();
-    let eig = generalized_eigen(&col, &identity, m).ok_or("the pencil's eigenvalues failed")?;
+    let eig = generalized_eigen(&col, &identity, m).ok_or(PencilError::EigenvaluesFailed)?;
     Ok(eig
         .iter()
         .map(|((ar, ai), (br, bi), _)| {
@@ -97,7 +131,42 @@ pub fn matrix_pencil(
     groups: Option<&[usize]>,
     dt: f64,
     spec: &PencilSpec,
-) -> Result<Vec<Pole>, String> {
+) -> Result<Vec<Pole>, PencilError> {
+    let scaled = scaled_signals(signals, groups, spec);
+    let k = scaled.iter().map(Vec::len).min().unwrap_or(0);
+    if k < 12 {
+        return Err(PencilError::TooFewSamples { samples: k });
+    }
+    let hankel = Hankel::decompose(&scaled, k)?;
+    let m = hankel.model_order(spec);
+    if m == 0 {
+        return Ok(Vec::new());
+    }
+    let poles = distinct_poles(&hankel.stable_poles(m)?, k);
+    let amplitude = amplitudes(&poles, &scaled, k)?;
+    let mut out: Vec<Pole> = poles
+        .iter()
+        .zip(&amplitude)
+        .filter(|(_, a)| **a >= spec.amplitude_tolerance)
+        .map(|(z, a)| {
+            let r = (z.re * z.re + z.im * z.im).sqrt();
+            Pole {
+                s: c64::new(r.ln() / dt, z.im.atan2(z.re) / dt),
+                amplitude: *a,
+            }
+        })
+        .collect();
+    out.sort_by(|a, b| b.amplitude.total_cmp(&a.amplitude));
+    Ok(out)
+}
+
+/// The excited signals, each divided by its group's scale (the largest peak of its finite
+/// signals); signals that are not finite, or not excited, are dropped.
+fn scaled_signals(
+    signals: &[Vec<f64>],
+    groups: Option<&[usize]>,
+    spec: &PencilSpec,
+) -> Vec<Vec<f64>> {
     let peak_of = |y: &Vec<f64>| y.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let group = |i: usize| groups.map_or(i, |g| g[i]);
     let finite = |y: &Vec<f64>| y.iter().all(|x| x.is_finite());
@@ -108,81 +177,97 @@ pub fn matrix_pencil(
             .map(|j| peak_of(&signals[j]))
             .fold(0.0f64, f64::max)
     };
-    let scaled: Vec<Vec<f64>> = (0..signals.len())
+    (0..signals.len())
         .filter_map(|i| {
             let (y, s) = (&signals[i], scale(i));
             (finite(y) && peak_of(y) > spec.unexcited * s && s > 0.0)
                 .then(|| y.iter().map(|x| x / s).collect())
         })
-        .collect();
-    let k = scaled.iter().map(Vec::len).min().unwrap_or(0);
-    if k < 12 {
-        return Err(format!(
-            "a transient fit needs at least 12 samples of a signal that is not zero throughout, got {k}"
-        ));
-    }
-    let l = k / 3;
-    let rows = k - l;
-    let width = l + 1;
-    let mut y = vec![0.0; rows * scaled.len() * width];
-    for (s, sig) in scaled.iter().enumerate() {
-        for i in 0..rows {
-            for j in 0..width {
-                y[(s * rows + i) * width + j] = sig[i + j];
+        .collect()
+}
+
+/// The stacked Hankel matrices of the signals (`K - L` rows of `L + 1` samples each,
+/// `L = K / 3`), decomposed: singular values, largest first, and right singular vectors.
+struct Hankel {
+    /// The pencil parameter `L`.
+    l: usize,
+    sv: Vec<f64>,
+    vs: Vec<f64>,
+}
+
+impl Hankel {
+    fn decompose(scaled: &[Vec<f64>], k: usize) -> Result<Hankel, PencilError> {
+        let l = k / 3;
+        let rows = k - l;
+        let width = l + 1;
+        let mut y = vec![0.0; rows * scaled.len() * width];
+        for (s, sig) in scaled.iter().enumerate() {
+            for i in 0..rows {
+                for j in 0..width {
+                    y[(s * rows + i) * width + j] = sig[i + j];
+                }
             }
         }
+        let (sv, vs) = svd_right(&y, rows * scaled.len(), width).ok_or(PencilError::SvdFailed)?;
+        let smax = sv.first().copied().unwrap_or(0.0);
+        if smax.is_nan() || smax <= 0.0 {
+            return Err(PencilError::NoEnergy);
+        }
+        Ok(Hankel { l, sv, vs })
     }
-    let (sv, vs) = svd_right(&y, rows * scaled.len(), width)
-        .ok_or("the singular value decomposition failed")?;
-    let smax = sv.first().copied().unwrap_or(0.0);
 
-    if smax.is_nan() || smax <= 0.0 {
-        return Err("the signals carry no energy".into());
+    /// The model order: singular values above the tolerance, cut at the last gap of more
+    /// than `gap` between neighbours (the noise floor of the integration) if there is one.
+    fn model_order(&self, spec: &PencilSpec) -> usize {
+        let sv = &self.sv;
+        let smax = sv[0];
+        let above = sv
+            .iter()
+            .take_while(|&&x| x > spec.rank_tolerance * smax)
+            .count()
+            .min(spec.max_order)
+            .min(self.l);
+        (1..above.min(sv.len() - 1) + 1)
+            .rev()
+            .find(|&k| sv[k] * spec.gap < sv[k - 1])
+            .unwrap_or(above)
     }
-    // The model order: singular values above the tolerance, cut at the last gap of more than
-    // `gap` between neighbours (the noise floor of the integration) if there is one.
-    let above = sv
-        .iter()
-        .take_while(|&&x| x > spec.rank_tolerance * smax)
-        .count()
-        .min(spec.max_order)
-        .min(l);
-    let m = (1..above.min(sv.len() - 1) + 1)
-        .rev()
-        .find(|&k| sv[k] * spec.gap < sv[k - 1])
-        .unwrap_or(above);
-    if m == 0 {
-        return Ok(Vec::new());
-    }
-    let zs = pencil_poles(&vs, width, m)?;
-    // Stabilization: a pole of the data stays put when the order grows by 2, 4 and 6; poles
-    // fitted to the noise move. Keep the poles of order M found again at the larger orders
-    // (within 1e-3 of |ln z|, i.e. of |s| dt), when the data allow them.
-    let extra: Vec<Vec<c64>> = [m + 2, m + 4, m + 6]
-        .iter()
-        .filter(|&&o| o <= l && o <= sv.len())
-        .map(|&o| pencil_poles(&vs, width, o))
-        .collect::<Result<_, _>>()?;
-    let log_of = |z: &c64| c64::new((z.re * z.re + z.im * z.im).sqrt().ln(), z.im.atan2(z.re));
-    let zs: Vec<c64> = zs
-        .into_iter()
-        .filter(|z| {
-            let a = log_of(z);
-            extra.iter().all(|set| {
-                set.iter().any(|w| {
-                    let b = log_of(w);
-                    (a.re - b.re).abs() + (a.im - b.im).abs()
-                        <= 1e-3 * (a.re * a.re + a.im * a.im).sqrt().max(1e-3)
+
+    /// Stabilization: a pole of the data stays put when the order grows by 2, 4 and 6; poles
+    /// fitted to the noise move. Keeps the poles of order `m` found again at the larger
+    /// orders (within 1e-3 of |ln z|, i.e. of |s| dt), when the data allow them.
+    fn stable_poles(&self, m: usize) -> Result<Vec<c64>, PencilError> {
+        let (l, width) = (self.l, self.l + 1);
+        let zs = pencil_poles(&self.vs, width, m)?;
+        let extra: Vec<Vec<c64>> = [m + 2, m + 4, m + 6]
+            .iter()
+            .filter(|&&o| o <= l && o <= self.sv.len())
+            .map(|&o| pencil_poles(&self.vs, width, o))
+            .collect::<Result<_, _>>()?;
+        let log_of = |z: &c64| c64::new((z.re * z.re + z.im * z.im).sqrt().ln(), z.im.atan2(z.re));
+        Ok(zs
+            .into_iter()
+            .filter(|z| {
+                let a = log_of(z);
+                extra.iter().all(|set| {
+                    set.iter().any(|w| {
+                        let b = log_of(w);
+                        (a.re - b.re).abs() + (a.im - b.im).abs()
+                            <= 1e-3 * (a.re * a.re + a.im * a.im).sqrt().max(1e-3)
+                    })
                 })
             })
-        })
-        .collect();
+            .collect())
+    }
+}
+
+/// The poles the data resolve, `Im z >= 0`, each once: poles that vanish within a sample, or
+/// grow by more than 1e12 over the `k` samples, are noise in the pencil's rank.
+fn distinct_poles(zs: &[c64], k: usize) -> Vec<c64> {
     let tiny = 1e-9;
     let mut poles: Vec<c64> = Vec::new();
-    // Poles that vanish within a sample, or grow by more than 1e12 over the window, are not
-    // resolved by the data (noise in the pencil's rank).
     let span = (k - 1) as f64;
-    for z in &zs {
+    for z in zs {
         let r = (z.re * z.re + z.im * z.im).sqrt();
         if z.im < -tiny * r || r < 1e-3 || span * r.ln() > 12.0 * std::f64::consts::LN_10 {
             continue;
@@ -199,6 +284,12 @@ pub fn matrix_pencil(
             poles.push(z);
         }
     }
+    poles
+}
+
+/// Each pole's largest contribution over the window relative to the peak of the signal where
+/// it is largest: a least-squares fit of the signals by the poles' real modes.
+fn amplitudes(poles: &[c64], scaled: &[Vec<f64>], k: usize) -> Result<Vec<f64>, PencilError> {
     // Real modes of each pole over the samples: z^k = r^k (cos k th + i sin k th).
     let mut columns: Vec<(usize, Vec<f64>)> = Vec::new();
     for (p, z) in poles.iter().enumerate() {
@@ -211,7 +302,7 @@ pub fn matrix_pencil(
     }
     let basis = DMatrix::<f64>::from_fn(k, columns.len(), |i, j| columns[j].1[i]);
     let b = DMatrix::<f64>::from_fn(k, scaled.len(), |i, s| scaled[s][i]);
-    let coefficients = solve_ls(&basis, &b).ok_or("the amplitude fit failed")?;
+    let coefficients = solve_ls(&basis, &b).ok_or(PencilError::AmplitudeFitFailed)?;
     let mut amplitude = vec![0.0f64; poles.len()];
     for s in 0..scaled.len() {
         let c = coefficients.column(s);
@@ -225,20 +316,7 @@ pub fn matrix_pencil(
             amplitude[p] = amplitude[p].max(reach);
         }
     }
-    let mut out: Vec<Pole> = poles
-        .iter()
-        .zip(&amplitude)
-        .filter(|(_, a)| **a >= spec.amplitude_tolerance)
-        .map(|(z, a)| {
-            let r = (z.re * z.re + z.im * z.im).sqrt();
-            Pole {
-                s: c64::new(r.ln() / dt, z.im.atan2(z.re) / dt),
-                amplitude: *a,
-            }
-        })
-        .collect();
-    out.sort_by(|a, b| b.amplitude.total_cmp(&a.amplitude));
-    Ok(out)
+    Ok(amplitude)
 }
 
 #[cfg(test)]

@@ -1,15 +1,15 @@
 //! `mbd modes`: the flags, usage errors (exit 2), the printed summary; the analysis is
 //! `mbd::modes` (one state) and `mbd::study::fan` (a sweep).
 
-use crate::{
-    compile, create_outputs, draw, read, report, sweep_values, usage, Format, FsLoader, EXIT_MODEL,
-    EXIT_RUNTIME,
+use super::progress::Evaluations;
+use super::swept::Swept;
+use super::{
+    compile, create_outputs, draw, exit_unless_failed, read, report, sink, to_path, usage, Format,
+    Jobs, EXIT_MODEL, EXIT_RUNTIME,
 };
 use mbd::settings::Request;
 use mbd::solve::modes::{Frame, Modes};
 use mbd::study::fan::{self, FanSpec};
-use mbd::study::sweep::Tick;
-use std::io::{IsTerminal, Write};
 use std::process::ExitCode;
 
 pub const LONG_ABOUT: &str = "\
@@ -82,10 +82,15 @@ pub fn modes(a: ModesArgs) -> ExitCode {
         Ok(t) => t,
         Err(code) => return code,
     };
-    if a.sweep.is_some() {
-        return sweep(&a, &text);
+    match &a.sweep {
+        Some(spec) => sweep(&a, &text, spec),
+        None => at_start(&a, &text),
     }
-    let c = match compile(&a.model, &text, &a.set, Request::default(), a.format) {
+}
+
+/// The modes about the initial state: the table, the shapes, the summary.
+fn at_start(a: &ModesArgs, text: &str) -> ExitCode {
+    let c = match compile(&a.model, text, &a.set, Request::default(), a.format) {
         Ok(c) => c,
         Err(code) => return code,
     };
@@ -100,28 +105,20 @@ pub fn modes(a: ModesArgs) -> ExitCode {
             });
         }
     };
-    let open = |p: Option<&str>| -> Result<Box<dyn Write>, ExitCode> {
-        match p {
-            Some(p) => std::fs::File::create(p)
-                .map(|f| Box::new(f) as Box<dyn Write>)
-                .map_err(|e| usage(&format!("cannot create output file `{p}`: {e}"))),
-            None => Ok(Box::new(std::io::stdout().lock())),
-        }
-    };
-    let mut sink = match open(a.output.as_deref()) {
+    let mut table = match sink(a.output.as_deref()) {
         Ok(s) => s,
         Err(code) => return code,
     };
-    if let Err(e) = mbd::write_modes(&m, a.count, &mut sink) {
+    if let Err(e) = mbd::write_modes(&m, a.count, &mut table) {
         return usage(&format!("cannot write the modes: {e}"));
     }
-    drop(sink);
+    drop(table);
     if let Some(p) = &a.shapes {
-        let mut sink = match open(Some(p)) {
+        let mut shapes = match sink(Some(p)) {
             Ok(s) => s,
             Err(code) => return code,
         };
-        if let Err(e) = mbd::write_shapes(&c, &m, a.count, &mut sink) {
+        if let Err(e) = mbd::write_shapes(&c, &m, a.count, &mut shapes) {
             return usage(&format!("cannot write the shapes: {e}"));
         }
     }
@@ -142,11 +139,7 @@ fn summary(c: &mbd::Compiled, m: &Modes, count: usize, output: Option<&str>) -> 
         ),
         Frame::Frozen { .. } => ", FROZEN-TIME eigenvalues at t = 0 (the motion is not steady: these are not the model's modes; `mbd stability` analyses a periodic system)".to_string(),
     };
-    let mut line = format!(
-        "{}: {shown} modes{frame}{}",
-        c.model.name,
-        output.map(|p| format!(" to {p}")).unwrap_or_default()
-    );
+    let mut line = format!("{}: {shown} modes{frame}{}", c.model.name, to_path(output));
     if m.moved > 0.0 {
         line.push_str(&format!(
             "\nnote: about the steady motion found from the initial state, which it moves by up to {:.3e} m",
@@ -168,78 +161,38 @@ fn summary(c: &mbd::Compiled, m: &Modes, count: usize, output: Option<&str>) -> 
     line
 }
 
-fn sweep(a: &ModesArgs, text: &str) -> ExitCode {
-    let Some(spec) = &a.sweep else {
-        return usage("internal: no --sweep");
-    };
+/// `--sweep`: the modes at every value, followed across them (a fan plot).
+fn sweep(a: &ModesArgs, text: &str, spec: &str) -> ExitCode {
     let Some(output) = &a.output else {
         return usage("--sweep needs -o FAN.csv");
     };
-    let (param, values) = match sweep_values(&a.model, text, &a.set, spec, "Omega=0:600rpm:50rpm") {
-        Ok(x) => x,
+    let swept = match Swept::parse(&a.model, text, &a.set, spec, "Omega=0:600rpm:50rpm") {
+        Ok(s) => s,
         Err(code) => return code,
     };
-    // The model compiles at the first value (its errors and warnings, once).
-    let mut first = a.set.clone();
-    first.push(format!("{param}={}", values[0]));
-    let c = match compile(&a.model, text, &first, Request::default(), a.format) {
+    let c = match swept.compile_first(&a.model, text, &a.set, a.format) {
         Ok(c) => c,
         Err(code) => return code,
     };
-    if let Err(d) = &c.lowered {
-        report(std::slice::from_ref(d), &c.sources, a.format);
-        return ExitCode::from(EXIT_MODEL);
-    }
-    if !c.model.params.iter().any(|(n, _)| *n == param) {
-        let known: Vec<&str> = c.model.params.iter().map(|(n, _)| n.as_str()).collect();
-        return usage(&format!(
-            "model `{}` has no param `{param}`; its params are: {}",
-            a.model,
-            known.join(", ")
-        ));
-    }
     let (mut csv, mut chart) = match create_outputs(output, a.chart.as_deref()) {
         Ok(f) => f,
         Err(code) => return code,
     };
-    let (path, sets) = (a.model.as_str(), a.set.as_slice());
-    let compile_job = |extra: &[String]| {
-        let mut all = sets.to_vec();
-        all.extend_from_slice(extra);
-        mbd::compile_with(path, text, &all, Request::default(), &FsLoader::new()).map_err(|f| {
-            f.diagnostics
-                .iter()
-                .find(|d| d.is_error())
-                .map(|d| format!("{} {}", d.code.as_str(), d.message))
-                .unwrap_or_else(|| "the model does not compile".to_string())
-        })
+    let jobs = Jobs {
+        path: &a.model,
+        text,
+        sets: &a.set,
     };
-    let terminal = std::io::stderr().is_terminal();
-    let bar = terminal.then(|| {
-        let b = indicatif::ProgressBar::new(0);
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} values, {eta} left",
-        ) {
-            b.set_style(style.progress_chars("=> "));
-        }
-        b
-    });
-    let tick = |t: Tick| match (&bar, t) {
-        (Some(b), Tick::Planned(n)) => b.inc_length(n as u64),
-        (Some(b), Tick::Done(_)) => b.inc(1),
-        (None, Tick::Done(line)) => eprintln!("{line}"),
-        (None, Tick::Planned(_)) => {}
-    };
+    let progress = Evaluations::new("values");
+    let param = swept.param;
     let spec = FanSpec {
         param: param.clone(),
-        values,
+        values: swept.values,
         count: a.count,
         frozen: a.frozen,
     };
-    let result = fan::fan(&spec, &compile_job, &tick);
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    let result = fan::fan(&spec, &|extra| jobs.with_sets(extra), &|t| progress.tick(t));
+    progress.finish();
     if let Err(e) = result.write_csv(&mut csv) {
         return usage(&format!("cannot write `{output}`: {e}"));
     }
@@ -247,17 +200,12 @@ fn sweep(a: &ModesArgs, text: &str) -> ExitCode {
         let title = format!("{}: natural frequencies against {param}", c.model.name);
         draw(p, f, &result.chart(&title));
     }
-    let failed: Vec<&fan::FanPoint> = result
-        .points
-        .iter()
-        .filter(|p| p.failure.is_some())
-        .collect();
-    for p in &failed {
-        eprintln!(
-            "error: {param} = {}: {}",
-            p.value,
-            p.failure.as_deref().unwrap_or_default()
-        );
+    let mut failed = false;
+    for p in &result.points {
+        if let Some(e) = &p.failure {
+            eprintln!("error: {param} = {}: {e}", p.value);
+            failed = true;
+        }
     }
     if a.format == Format::Human {
         eprintln!(
@@ -271,9 +219,5 @@ fn sweep(a: &ModesArgs, text: &str) -> ExitCode {
                 .unwrap_or_default()
         );
     }
-    if failed.is_empty() {
-        ExitCode::SUCCESS
-    } else {
-        ExitCode::from(EXIT_RUNTIME)
-    }
+    exit_unless_failed(failed)
 }

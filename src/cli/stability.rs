@@ -1,15 +1,13 @@
-//! `mbd stability` (part of the binary): parses the flags, reads the model and any reference
-//! file, runs the sweep through `mbd::study::sweep` with a progress bar, writes the CSV and the
-//! chart and prints the report. The analysis itself lives in the library.
+//! `mbd stability`: parses the flags, reads the model and any reference file, runs the sweep
+//! through `mbd::study::sweep` with a progress bar, writes the CSV and the chart and prints the
+//! report. The analysis itself lives in the library.
 
-use super::{
-    compile, create_outputs, draw, read, report, say, short, sweep_values, usage, Format, FsLoader,
-    EXIT_MODEL, EXIT_RUNTIME,
-};
+use super::progress::Evaluations;
+use super::swept::Swept;
+use super::{create_outputs, draw, exit_unless_failed, read, say, short, usage, Format, Jobs};
 use mbd::output::charts::Series;
-use mbd::settings::Request;
-use mbd::study::sweep::{self, Method, SweepSpec, Tick};
-use std::io::IsTerminal;
+use mbd::study::sweep::{self, Method, SweepSpec};
+use mbd::Compiled;
 use std::process::ExitCode;
 
 /// `mbd stability --help`.
@@ -102,109 +100,33 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         Ok(t) => t,
         Err(code) => return code,
     };
-    let (param, values) =
-        match sweep_values(&a.model, &text, &a.set, &a.sweep, "Omega_bar=0.8:2.6:0.05") {
-            Ok(x) => x,
-            Err(code) => return code,
-        };
-    if let Some(t) = a.period {
-        if !(t.is_finite() && t > 0.0) {
-            return usage(&format!(
-                "--period must be a positive time in seconds, got {t}"
-            ));
-        }
-    }
-    if !a.threshold.is_finite() {
-        return usage("--threshold must be a number (1/s)");
-    }
-    let window = match &a.window {
-        None => None,
-        Some(w) => {
-            let parsed = w.split_once(':').and_then(|(f, t)| {
-                Some((f.trim().parse::<f64>().ok()?, t.trim().parse::<f64>().ok()?))
-            });
-            match parsed {
-                Some((f, t)) if f.is_finite() && t.is_finite() && f >= 0.0 && t > f => Some((f, t)),
-                _ => {
-                    return usage(&format!(
-                        "--window takes FROM:TO in seconds with 0 <= FROM < TO, got `{w}`"
-                    ))
-                }
-            }
-        }
+    let swept = match Swept::parse(&a.model, &text, &a.set, &a.sweep, "Omega_bar=0.8:2.6:0.05") {
+        Ok(s) => s,
+        Err(code) => return code,
     };
-    let methods = match a.method {
-        MethodArg::Floquet => vec![Method::Floquet],
-        MethodArg::Prony => vec![Method::Prony],
-        MethodArg::Both => vec![Method::Floquet, Method::Prony],
+    let (methods, window) = match methods_and_window(&a) {
+        Ok(x) => x,
+        Err(code) => return code,
     };
-    let prony = methods.contains(&Method::Prony);
-    if !prony && (a.window.is_some() || a.signals.is_some()) {
-        return usage("--window and --signals belong to --method prony or both");
-    }
-    if methods.contains(&Method::Prony) && a.samples < 12 {
-        return usage("--samples must be at least 12");
-    }
-    // The model compiles at the first value (reports its errors and warnings once).
-    let mut first_sets = a.set.clone();
-    first_sets.push(format!("{param}={}", values[0]));
-    let c = match compile(
-        &a.model,
-        &text,
-        &first_sets,
-        Request::default(),
-        Format::Human,
-    ) {
+    let c = match swept.compile_first(&a.model, &text, &a.set, Format::Human) {
         Ok(c) => c,
         Err(code) => return code,
     };
-    if let Err(d) = &c.lowered {
-        report(std::slice::from_ref(d), &c.sources, Format::Human);
-        return ExitCode::from(EXIT_MODEL);
-    }
-    if !c.model.params.iter().any(|(n, _)| *n == param) {
-        let known: Vec<&str> = c.model.params.iter().map(|(n, _)| n.as_str()).collect();
-        return usage(&format!(
-            "model `{}` has no param `{param}`; its params are: {}",
-            a.model,
-            known.join(", ")
-        ));
-    }
-    let signals: Vec<String> = a
-        .signals
-        .as_deref()
-        .map(|s| s.split(',').map(|x| x.trim().to_string()).collect())
-        .unwrap_or_default();
-    let channels: Vec<&str> = c.model.outputs.iter().map(|o| o.column.as_str()).collect();
-    if let Some(bad) = signals.iter().find(|s| !channels.contains(&s.as_str())) {
-        return usage(&format!(
-            "model `{}` has no output channel `{bad}`; its channels are: {}",
-            a.model,
-            channels.join(", ")
-        ));
-    }
-    if prony && channels.is_empty() && signals.is_empty() {
-        return usage("Prony needs output channels to fit: the model declares no `output`");
-    }
-    if methods.contains(&Method::Floquet) && a.period.is_none() {
-        if let Err(e) = sweep::rotor_period(&c) {
-            return usage(&e);
-        }
-    }
-    let reference = match &a.reference {
-        None => Vec::new(),
-        Some(p) => match reference_series(p) {
-            Ok(s) => s,
-            Err(e) => return usage(&e),
-        },
+    let signals = match signals(&a, &c, &methods) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let reference = match a.reference.as_deref().map(reference_series).transpose() {
+        Ok(r) => r.unwrap_or_default(),
+        Err(code) => return code,
     };
     let (mut csv_file, mut chart_file) = match create_outputs(&a.output, a.chart.as_deref()) {
         Ok(files) => files,
         Err(code) => return code,
     };
     let spec = SweepSpec {
-        param: param.clone(),
-        values,
+        param: swept.param,
+        values: swept.values,
         methods,
         period: a.period,
         signals,
@@ -213,61 +135,111 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         threshold: a.threshold,
         refine: a.refine,
     };
-    let (path, sets) = (a.model.as_str(), a.set.as_slice());
-    let compile_job = |extra: &[String]| {
-        let mut all = sets.to_vec();
-        all.extend_from_slice(extra);
-        mbd::compile_with(path, &text, &all, Request::default(), &FsLoader::new()).map_err(|f| {
-            f.diagnostics
-                .iter()
-                .find(|d| d.is_error())
-                .map(|d| format!("{} {}", d.code.as_str(), d.message))
-                .unwrap_or_else(|| "the model does not compile".to_string())
-        })
+    let jobs = Jobs {
+        path: &a.model,
+        text: &text,
+        sets: &a.set,
     };
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = indicatif::ProgressBar::new(0);
-        if let Ok(style) = indicatif::ProgressStyle::with_template(
-            "{elapsed_precise} [{bar:40}] {pos}/{len} evaluations, {eta} left",
-        ) {
-            b.set_style(style.progress_chars("=> "));
-        }
-        b
-    });
-    // A bar on a terminal; elsewhere (a log, CI) a line per finished evaluation.
-    let tick = |t: Tick| match (&bar, t) {
-        (Some(b), Tick::Planned(n)) => b.inc_length(n as u64),
-        (Some(b), Tick::Done(_)) => b.inc(1),
-        (None, Tick::Done(line)) => eprintln!("{line}"),
-        (None, Tick::Planned(_)) => {}
-    };
-    let result = sweep::sweep(&spec, &compile_job, &tick);
-    if let Some(b) = &bar {
-        b.finish_and_clear();
-    }
+    let progress = Evaluations::new("evaluations");
+    let result = sweep::sweep(&spec, &|extra| jobs.with_sets(extra), &|t| progress.tick(t));
+    progress.finish();
     if let Err(e) = result.write_csv(&mut csv_file) {
         return usage(&format!("cannot write `{}`: {e}", a.output));
     }
     if let Some((p, f)) = chart_file.as_mut() {
-        let title = format!("{}: stability against {param}", c.model.name);
+        let title = format!("{}: stability against {}", c.model.name, spec.param);
         draw(p, f, &result.chart(&title, reference));
     }
     print_report(&result);
-    if result.points.iter().any(|p| p.failure.is_some()) {
-        ExitCode::from(EXIT_RUNTIME)
-    } else {
-        ExitCode::SUCCESS
+    exit_unless_failed(result.points.iter().any(|p| p.failure.is_some()))
+}
+
+/// The methods (the primary first) and Prony's window, with the flags that belong to them
+/// checked (usage errors exit 2).
+fn methods_and_window(a: &StabilityArgs) -> Result<(Vec<Method>, Option<Window>), ExitCode> {
+    if let Some(t) = a.period {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(usage(&format!(
+                "--period must be a positive time in seconds, got {t}"
+            )));
+        }
+    }
+    if !a.threshold.is_finite() {
+        return Err(usage("--threshold must be a number (1/s)"));
+    }
+    let window = a.window.as_deref().map(parse_window).transpose()?;
+    let methods = match a.method {
+        MethodArg::Floquet => vec![Method::Floquet],
+        MethodArg::Prony => vec![Method::Prony],
+        MethodArg::Both => vec![Method::Floquet, Method::Prony],
+    };
+    let prony = methods.contains(&Method::Prony);
+    if !prony && (a.window.is_some() || a.signals.is_some()) {
+        return Err(usage(
+            "--window and --signals belong to --method prony or both",
+        ));
+    }
+    if prony && a.samples < 12 {
+        return Err(usage("--samples must be at least 12"));
+    }
+    Ok((methods, window))
+}
+
+/// Prony's window, FROM and TO in seconds.
+type Window = (f64, f64);
+
+/// `--window FROM:TO` in seconds, `0 <= FROM < TO`.
+fn parse_window(w: &str) -> Result<Window, ExitCode> {
+    let parsed = w
+        .split_once(':')
+        .and_then(|(f, t)| Some((f.trim().parse::<f64>().ok()?, t.trim().parse::<f64>().ok()?)));
+    match parsed {
+        Some((f, t)) if f.is_finite() && t.is_finite() && f >= 0.0 && t > f => Ok((f, t)),
+        _ => Err(usage(&format!(
+            "--window takes FROM:TO in seconds with 0 <= FROM < TO, got `{w}`"
+        ))),
     }
 }
 
-/// The columns of a reference CSV as lines against its first column.
-fn reference_series(path: &str) -> Result<Vec<Series>, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("cannot read `{path}`: {e}"))?;
-    let (header, rows) = mbd::output::read_csv(&text).map_err(|e| format!("`{path}`: {e}"))?;
-    if header.len() < 2 {
-        return Err(format!(
-            "`{path}` needs the param in its first column and at least one more column"
+/// Prony's `--signals` (each an output channel of the model), and what each method needs of
+/// the model: Prony channels to fit, Floquet without `--period` a steady rotor speed.
+fn signals(a: &StabilityArgs, c: &Compiled, methods: &[Method]) -> Result<Vec<String>, ExitCode> {
+    let signals: Vec<String> = a
+        .signals
+        .as_deref()
+        .map(|s| s.split(',').map(|x| x.trim().to_string()).collect())
+        .unwrap_or_default();
+    let channels: Vec<&str> = c.model.outputs.iter().map(|o| o.column.as_str()).collect();
+    if let Some(bad) = signals.iter().find(|s| !channels.contains(&s.as_str())) {
+        return Err(usage(&format!(
+            "model `{}` has no output channel `{bad}`; its channels are: {}",
+            a.model,
+            channels.join(", ")
+        )));
+    }
+    if methods.contains(&Method::Prony) && channels.is_empty() && signals.is_empty() {
+        return Err(usage(
+            "Prony needs output channels to fit: the model declares no `output`",
         ));
+    }
+    if methods.contains(&Method::Floquet) && a.period.is_none() {
+        if let Err(e) = sweep::rotor_period(c) {
+            return Err(usage(&e.to_string()));
+        }
+    }
+    Ok(signals)
+}
+
+/// The columns of a reference CSV as lines against its first column.
+fn reference_series(path: &str) -> Result<Vec<Series>, ExitCode> {
+    let text =
+        std::fs::read_to_string(path).map_err(|e| usage(&format!("cannot read `{path}`: {e}")))?;
+    let (header, rows) =
+        mbd::output::read_csv(&text).map_err(|e| usage(&format!("`{path}`: {e}")))?;
+    if header.len() < 2 {
+        return Err(usage(&format!(
+            "`{path}` needs the param in its first column and at least one more column"
+        )));
     }
     Ok((1..header.len())
         .map(|k| Series {
@@ -308,7 +280,10 @@ fn print_report(s: &sweep::Sweep) {
         say(&format!(
             "refinement at {} failed: {}",
             short(r.value),
-            r.failure.as_deref().unwrap_or_default()
+            r.failure
+                .as_ref()
+                .map(|f| f.to_string())
+                .unwrap_or_default()
         ));
     }
     for n in &s.notes {

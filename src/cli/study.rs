@@ -1,16 +1,17 @@
-//! `mbd study` (part of the binary): parses and checks the flags, reads the model and any
-//! reference file, runs the study through `mbd::study`, writes its CSV and chart and prints
-//! the report. The study itself (runs, errors, orders, onsets) lives in the library.
+//! `mbd study`: parses and checks the flags, reads the model and any reference file, runs the
+//! study through `mbd::study`, writes its CSV and chart and prints the report. The study
+//! itself (runs, errors, orders, onsets) lives in the library.
 
 use super::{
-    compile, create_outputs, draw, read, report, say, short, usage, Format, FsLoader, EXIT_MODEL,
+    compile, create_outputs, draw, read, runnable, say, short, usage, ChartFile, Format, Jobs,
     EXIT_RUNTIME,
 };
 use mbd::settings::Request;
 use mbd::study::compare::Samples;
 use mbd::study::convergence::{self, ConvergenceSpec, ReferenceSpec};
 use mbd::study::stability::{self, Detector, StabilitySpec};
-use mbd::study::{split_list, IntegratorItem, StepList};
+use mbd::study::{parse_alphas, IntegratorItem, StepList};
+use std::fs::File;
 use std::process::ExitCode;
 
 /// `mbd study --help`.
@@ -88,31 +89,13 @@ pub struct StudyArgs {
 }
 
 pub fn study(a: StudyArgs) -> ExitCode {
-    let stability = match (&a.integrator, &a.alpha) {
-        (Some(_), Some(_)) => {
-            return usage("give --integrator LIST (a convergence study) or --alpha LIST (a stability study), not both")
-        }
-        (None, None) => {
-            return usage("say what to study: --integrator LIST (convergence, e.g. `--integrator hht,generalized-alpha`) or --alpha LIST (stability, e.g. `--alpha 0,-0.1`)")
-        }
-        (None, Some(_)) => true,
-        (Some(_), None) => false,
-    };
-    if stability && (a.reference.is_some() || a.at.is_some()) {
-        return usage("--reference and --at belong to convergence studies (--integrator), not to stability studies (--alpha)");
-    }
-    let steps = match (&a.steps, &a.dt) {
-        (Some(_), Some(_)) => return usage("give --steps LIST or --dt LIST, not both"),
-        (Some(s), None) => StepList::parse_counts(s).map(Some),
-        (None, Some(d)) => StepList::parse_dt(d).map(Some),
-        (None, None) if stability => Ok(None),
-        (None, None) => {
-            return usage("a convergence study needs the steps: --steps LIST (e.g. 100,200,400) or --dt LIST (seconds)")
-        }
-    };
-    let steps = match steps {
+    let stability = match is_stability(&a) {
         Ok(s) => s,
-        Err(e) => return usage(&e),
+        Err(code) => return code,
+    };
+    let steps = match step_list(&a, stability) {
+        Ok(s) => s,
+        Err(code) => return code,
     };
     let text = match read(&a.model) {
         Ok(t) => t,
@@ -130,127 +113,173 @@ pub fn study(a: StudyArgs) -> ExitCode {
         until: a.until,
         ..Request::default()
     };
-    let c = match compile(&a.model, &text, &a.set, base.clone(), Format::Human) {
+    let c = match compile(&a.model, &text, &a.set, base.clone(), Format::Human)
+        .and_then(|c| runnable(c, Format::Human))
+    {
         Ok(c) => c,
         Err(code) => return code,
     };
-    if let Err(d) = &c.lowered {
-        report(std::slice::from_ref(d), &c.sources, Format::Human);
-        return ExitCode::from(EXIT_MODEL);
-    }
-    let channels: Vec<&str> = c.model.outputs.iter().map(|o| o.column.as_str()).collect();
-    if !channels.contains(&a.channel.as_str()) {
-        let known = if channels.is_empty() {
-            "the model declares no outputs".to_string()
-        } else {
-            format!("its channels are: {}", channels.join(", "))
-        };
-        return usage(&format!(
-            "model `{}` has no output channel `{}`; {known}",
-            a.model, a.channel
-        ));
+    if let Err(code) = has_channel(&a, &c) {
+        return code;
     }
     let until = c.settings.until;
     let counts = match &steps {
         Some(s) => match s.counts(until) {
             Ok(n) => n,
-            Err(e) => return usage(&e),
+            Err(e) => return usage(&e.to_string()),
         },
         None => vec![c.settings.steps],
     };
     // Fail on unwritable outputs now, not after the runs.
-    let (mut csv_file, mut chart_file) = match create_outputs(&a.output, a.chart.as_deref()) {
+    let (csv, chart) = match create_outputs(&a.output, a.chart.as_deref()) {
         Ok(files) => files,
         Err(code) => return code,
     };
-    let (path, sets) = (a.model.as_str(), a.set.as_slice());
-    let compile_job = |o: &Request| {
-        mbd::compile_with(path, &text, sets, o.clone(), &FsLoader::new()).map_err(|f| {
-            f.diagnostics
-                .iter()
-                .find(|d| d.is_error())
-                .map(|d| format!("{} {}", d.code.as_str(), d.message))
-                .unwrap_or_else(|| "the model does not compile".to_string())
-        })
+    let run = Runs {
+        jobs: Jobs {
+            path: &a.model,
+            text: &text,
+            sets: &a.set,
+        },
+        base,
+        counts,
+        until,
+        title: format!("{}: {}", c.model.name, a.channel),
+        csv,
+        chart,
     };
-    let title = format!("{}: {}", c.model.name, a.channel);
     if stability {
-        let mut alphas = Vec::new();
-        let list = a.alpha.as_deref().unwrap_or_default();
-        match split_list(list, "--alpha") {
-            Ok(items) => {
-                for s in items {
-                    match s.parse::<f64>() {
-                        Ok(v) if (-1.0 / 3.0 - 1e-12..=0.0).contains(&v) => alphas.push(v),
-                        _ => {
-                            return usage(&format!(
-                                "--alpha: `{s}` is not an HHT alpha in [-1/3, 0]"
-                            ))
-                        }
-                    }
-                }
-            }
-            Err(e) => return usage(&e),
+        run.stability(&a)
+    } else {
+        run.convergence(&a, &c)
+    }
+}
+
+/// A stability study (`--alpha`) or a convergence study (`--integrator`); the flags that
+/// belong to the other kind are usage errors.
+fn is_stability(a: &StudyArgs) -> Result<bool, ExitCode> {
+    let stability = match (&a.integrator, &a.alpha) {
+        (Some(_), Some(_)) => {
+            return Err(usage("give --integrator LIST (a convergence study) or --alpha LIST (a stability study), not both"))
         }
+        (None, None) => {
+            return Err(usage("say what to study: --integrator LIST (convergence, e.g. `--integrator hht,generalized-alpha`) or --alpha LIST (stability, e.g. `--alpha 0,-0.1`)"))
+        }
+        (None, Some(_)) => true,
+        (Some(_), None) => false,
+    };
+    if stability && (a.reference.is_some() || a.at.is_some()) {
+        return Err(usage("--reference and --at belong to convergence studies (--integrator), not to stability studies (--alpha)"));
+    }
+    Ok(stability)
+}
+
+/// `--steps LIST` or `--dt LIST`; `None`: the model's step (stability studies only).
+fn step_list(a: &StudyArgs, stability: bool) -> Result<Option<StepList>, ExitCode> {
+    let steps = match (&a.steps, &a.dt) {
+        (Some(_), Some(_)) => return Err(usage("give --steps LIST or --dt LIST, not both")),
+        (Some(s), None) => StepList::parse_counts(s).map(Some),
+        (None, Some(d)) => StepList::parse_dt(d).map(Some),
+        (None, None) if stability => Ok(None),
+        (None, None) => {
+            return Err(usage("a convergence study needs the steps: --steps LIST (e.g. 100,200,400) or --dt LIST (seconds)"))
+        }
+    };
+    steps.map_err(|e| usage(&e.to_string()))
+}
+
+/// The studied channel must be one of the model's outputs.
+fn has_channel(a: &StudyArgs, c: &mbd::Compiled) -> Result<(), ExitCode> {
+    let channels: Vec<&str> = c.model.outputs.iter().map(|o| o.column.as_str()).collect();
+    if channels.contains(&a.channel.as_str()) {
+        return Ok(());
+    }
+    let known = if channels.is_empty() {
+        "the model declares no outputs".to_string()
+    } else {
+        format!("its channels are: {}", channels.join(", "))
+    };
+    Err(usage(&format!(
+        "model `{}` has no output channel `{}`; {known}",
+        a.model, a.channel
+    )))
+}
+
+/// What both kinds of study share: the jobs' model and settings, the steps, the outputs.
+struct Runs<'a> {
+    jobs: Jobs<'a>,
+    base: Request,
+    counts: Vec<usize>,
+    until: f64,
+    title: String,
+    csv: File,
+    chart: ChartFile<'a>,
+}
+
+impl Runs<'_> {
+    fn stability(mut self, a: &StudyArgs) -> ExitCode {
+        let alphas = match parse_alphas(a.alpha.as_deref().unwrap_or_default()) {
+            Ok(v) => v,
+            Err(e) => return usage(&e.to_string()),
+        };
         let spec = StabilitySpec {
             channel: a.channel.clone(),
             alphas,
-            steps: counts,
-            until,
+            steps: self.counts,
+            until: self.until,
             detector: Detector::default(),
         };
-        let rows = stability::stability(&spec, &base, &compile_job);
-        if let Err(e) = stability::write_csv(&rows, &mut csv_file) {
+        let compile = |r: &Request| self.jobs.with_request(r);
+        let rows = stability::stability(&spec, &self.base, &compile);
+        if let Err(e) = stability::write_csv(&rows, &mut self.csv) {
             return usage(&format!("cannot write `{}`: {e}", a.output));
         }
-        if let Some((p, f)) = chart_file.as_mut() {
-            draw(p, f, &stability::chart(&rows, &title, &a.channel));
+        if let Some((p, f)) = self.chart.as_mut() {
+            draw(p, f, &stability::chart(&rows, &self.title, &a.channel));
         }
-        print_stability(&rows, until);
-        return ExitCode::SUCCESS;
+        print_stability(&rows, self.until);
+        ExitCode::SUCCESS
     }
-    let mut integrators = Vec::new();
-    match split_list(a.integrator.as_deref().unwrap_or_default(), "--integrator") {
-        Ok(items) => {
-            for s in items {
-                match IntegratorItem::parse(s) {
-                    Ok(i) => integrators.push(i),
-                    Err(e) => return usage(&e),
-                }
+
+    fn convergence(mut self, a: &StudyArgs, c: &mbd::Compiled) -> ExitCode {
+        let integrators =
+            match IntegratorItem::parse_list(a.integrator.as_deref().unwrap_or_default()) {
+                Ok(i) => i,
+                Err(e) => return usage(&e.to_string()),
+            };
+        let until = self.until;
+        if let Some(t) = a.at {
+            if !(t >= -1e-9 * until && t <= until * (1.0 + 1e-9)) {
+                return usage(&format!(
+                    "--at {t} lies outside the run, which goes from 0 to {until} s"
+                ));
             }
         }
-        Err(e) => return usage(&e),
-    }
-    if let Some(t) = a.at {
-        if !(t >= -1e-9 * until && t <= until * (1.0 + 1e-9)) {
-            return usage(&format!(
-                "--at {t} lies outside the run, which goes from 0 to {until} s"
-            ));
+        let reference = match reference(a, c, until) {
+            Ok(r) => r,
+            Err(code) => return code,
+        };
+        let spec = ConvergenceSpec {
+            channel: a.channel.clone(),
+            at: a.at,
+            integrators,
+            steps: self.counts,
+            until,
+            reference,
+        };
+        let compile = |r: &Request| self.jobs.with_request(r);
+        let study = convergence::convergence(&spec, &self.base, &compile);
+        if let Err(e) = study.write_csv(&mut self.csv) {
+            return usage(&format!("cannot write `{}`: {e}", a.output));
         }
-    }
-    let reference = match reference(&a, &c, until) {
-        Ok(r) => r,
-        Err(code) => return code,
-    };
-    let spec = ConvergenceSpec {
-        channel: a.channel.clone(),
-        at: a.at,
-        integrators,
-        steps: counts,
-        until,
-        reference,
-    };
-    let study = convergence::convergence(&spec, &base, &compile_job);
-    if let Err(e) = study.write_csv(&mut csv_file) {
-        return usage(&format!("cannot write `{}`: {e}", a.output));
-    }
-    if let Some((p, f)) = chart_file.as_mut() {
-        draw(p, f, &study.chart(&title, &a.channel));
-    }
-    print_convergence(&study, &spec);
-    match study.finest.as_ref().and_then(|f| f.failure.as_ref()) {
-        Some(_) => ExitCode::from(EXIT_RUNTIME),
-        None => ExitCode::SUCCESS,
+        if let Some((p, f)) = self.chart.as_mut() {
+            draw(p, f, &study.chart(&self.title, &a.channel));
+        }
+        print_convergence(&study, &spec);
+        match study.finest.as_ref().and_then(|f| f.failure.as_ref()) {
+            Some(_) => ExitCode::from(EXIT_RUNTIME),
+            None => ExitCode::SUCCESS,
+        }
     }
 }
 
@@ -291,7 +320,8 @@ fn reference(a: &StudyArgs, c: &mbd::Compiled, until: f64) -> Result<ReferenceSp
     }
 }
 
-/// Renders a chart into its (already created) file; a chart with nothing to draw is a note.
+/// The convergence report: the reference, the table, the failures, the observed orders and
+/// the CPU time to reach an error.
 fn print_convergence(study: &convergence::Convergence, spec: &ConvergenceSpec) {
     match (&spec.reference, &study.finest) {
         (ReferenceSpec::Exact(_), _) => say(&format!(
@@ -374,6 +404,7 @@ fn print_convergence(study: &convergence::Convergence, spec: &ConvergenceSpec) {
     }
 }
 
+/// The stability report: the table, then each run's onset.
 fn print_stability(rows: &[stability::StabilityRow], until: f64) {
     let several_steps = rows.iter().any(|r| r.steps != rows[0].steps);
     say(&format!(

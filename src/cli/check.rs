@@ -1,0 +1,120 @@
+//! `mbd check`: a model's summary, or one stage of its compilation (`--emit`); a library
+//! file's components. Exit 1 when the model has errors.
+
+use super::{compile, read, report, say, Format, FsLoader, EXIT_MODEL};
+use clap::ValueEnum;
+use mbd::settings::Request;
+use std::process::ExitCode;
+
+#[derive(clap::Args)]
+pub struct CheckArgs {
+    model: String,
+    #[arg(long, value_enum, default_value = "human")]
+    format: Format,
+    /// Print a stage instead of the summary.
+    #[arg(long, value_enum)]
+    emit: Option<Emit>,
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    set: Vec<String>,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Emit {
+    Ast,
+    Model,
+    Dofs,
+    #[value(alias = "system")]
+    Ir,
+}
+
+pub fn check(a: CheckArgs) -> ExitCode {
+    let (path, format, sets) = (a.model.as_str(), a.format, a.set.as_slice());
+    let text = match read(path) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    if mbd::is_library(&text) {
+        return library(path, &text, format);
+    }
+    let c = match compile(path, &text, sets, Request::default(), format) {
+        Ok(c) => c,
+        Err(code) => return code,
+    };
+    let json = |v: Result<String, serde_json::Error>| {
+        v.unwrap_or_else(|e| format!("{{\"error\": \"{e}\"}}"))
+    };
+    let out = match a.emit {
+        Some(Emit::Ast) => json(serde_json::to_string_pretty(&c.ast)),
+        Some(Emit::Model) => json(serde_json::to_string_pretty(&c.model)),
+        Some(Emit::Dofs) => json(serde_json::to_string_pretty(&c.model.dofs)),
+        Some(Emit::Ir) => match &c.lowered {
+            Ok(l) => json(serde_json::to_string_pretty(&l.system)),
+            Err(d) => {
+                report(std::slice::from_ref(d), &c.sources, format);
+                return ExitCode::from(EXIT_MODEL);
+            }
+        },
+        None => summary(&c, format),
+    };
+    say(&out);
+    ExitCode::SUCCESS
+}
+
+fn summary(c: &mbd::Compiled, format: Format) -> String {
+    let m = &c.model;
+    let n = m.dofs.len();
+    let mult = m.dofs.multipliers();
+    let nodes = m.bodies.len() + m.beams.iter().map(|b| b.nodes.len()).sum::<usize>();
+    let columns: Vec<&str> = m.outputs.iter().map(|o| o.column.as_str()).collect();
+    let nonzeros = c
+        .lowered
+        .as_ref()
+        .ok()
+        .map(|l| mbd::runtime::Pattern::of(n, &l.system.elements).nnz());
+    if format == Format::Json {
+        return serde_json::json!({
+            "model": m.name, "bodies": m.bodies.len(), "beams": m.beams.len(), "nodes": nodes,
+            "joints": m.joints.len(), "dofs": n - mult - m.dofs.extras(), "extra_unknowns": m.dofs.extras(),
+            "multipliers": mult, "unknowns": n, "bandwidth": m.dofs.bandwidth, "nonzeros": nonzeros,
+            "channels": columns, "steps": c.settings.steps, "dt": c.settings.dt, "until": c.settings.until,
+            "runnable": c.lowered.is_ok(),
+        })
+        .to_string();
+    }
+    let runnable = match &c.lowered {
+        Ok(_) => String::new(),
+        Err(d) => format!("\n  note: {}", d.message),
+    };
+    format!(
+        "model {}: ok\n{}\n  nonzeros     {}\n  outputs      {}\n  solve        {} steps of {} s to {} s{runnable}",
+        m.name,
+        mbd::model::topology::report(m),
+        nonzeros.map(|x| x.to_string()).unwrap_or_else(|| "-".to_string()),
+        std::iter::once("t").chain(columns.iter().copied()).collect::<Vec<_>>().join(", "),
+        c.settings.steps,
+        c.settings.dt,
+        c.settings.until
+    )
+}
+
+/// `mbd check` of a library file: its components.
+fn library(path: &str, text: &str, format: Format) -> ExitCode {
+    match mbd::check_library(path, text, &FsLoader::new()) {
+        Ok((components, warnings)) => {
+            report(&warnings.diagnostics, &warnings.sources, format);
+            if format == Format::Json {
+                say(&serde_json::json!({ "library": path, "components": components }).to_string());
+            } else {
+                say(&format!(
+                    "library {path}: ok\n  components\n    {}",
+                    components.join("\n    ")
+                ));
+            }
+            ExitCode::SUCCESS
+        }
+        Err(f) => {
+            report(&f.diagnostics, &f.sources, format);
+            ExitCode::from(EXIT_MODEL)
+        }
+    }
+}

@@ -1,0 +1,156 @@
+//! `mbd run`: the solver flags (checked by `settings::Request::check`, exit 2), the CSV on a
+//! file or standard output, the progress bar and the closing summary; exit 3 when the
+//! simulation fails (the rows before the failure are kept).
+
+use super::progress::Steps;
+use super::{compile, read, report, runnable, sink, to_path, usage, Format, EXIT_RUNTIME};
+use clap::ValueEnum;
+use mbd::settings::{Method, Request, Rotations, Start};
+use std::process::ExitCode;
+
+#[derive(clap::Args)]
+pub struct RunArgs {
+    /// The model file.
+    model: String,
+    /// Write the CSV here (default: standard output).
+    #[arg(short = 'o', long = "output")]
+    output: Option<String>,
+    /// Override a param: NAME=VALUE, VALUE in SI units or with units (V0=5, V0=5m/s).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    set: Vec<String>,
+    /// Time integrator.
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorArg>,
+    /// HHT alpha, in [-1/3, 0].
+    #[arg(long, allow_negative_numbers = true)]
+    alpha: Option<f64>,
+    /// Generalized-alpha spectral radius at infinity, in [0, 1].
+    #[arg(long)]
+    rho_inf: Option<f64>,
+    /// Rotation treatment: incremental (default) or conformal (the paper's).
+    #[arg(long, value_enum)]
+    rotations: Option<RotationsArg>,
+    /// Time step in seconds.
+    #[arg(long, conflicts_with = "steps")]
+    dt: Option<f64>,
+    /// Number of steps (the time step becomes until/N).
+    #[arg(long)]
+    steps: Option<usize>,
+    /// End time in seconds.
+    #[arg(long)]
+    until: Option<f64>,
+    /// Write every K-th step.
+    #[arg(long)]
+    every: Option<usize>,
+    /// Initial accelerations: consistent (default) or zero (the paper's start).
+    #[arg(long, value_enum)]
+    start: Option<StartArg>,
+    /// Diagnostics format.
+    #[arg(long, value_enum, default_value = "human")]
+    format: Format,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum IntegratorArg {
+    Hht,
+    GeneralizedAlpha,
+    Fet,
+    Static,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum RotationsArg {
+    Incremental,
+    Conformal,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum StartArg {
+    Consistent,
+    Zero,
+}
+
+impl RunArgs {
+    /// What the flags ask of the solver (not yet checked).
+    fn request(&self) -> Request {
+        Request {
+            method: self.integrator.map(|i| match i {
+                IntegratorArg::Hht => Method::Hht,
+                IntegratorArg::GeneralizedAlpha => Method::GeneralizedAlpha,
+                IntegratorArg::Fet => Method::Fet,
+                IntegratorArg::Static => Method::Static,
+            }),
+            alpha: self.alpha,
+            rho_inf: self.rho_inf,
+            rotations: self.rotations.map(|r| match r {
+                RotationsArg::Incremental => Rotations::Incremental,
+                RotationsArg::Conformal => Rotations::Conformal,
+            }),
+            dt: self.dt,
+            steps: self.steps,
+            until: self.until,
+            every: self.every,
+            start: self.start.map(|s| match s {
+                StartArg::Consistent => Start::Consistent,
+                StartArg::Zero => Start::ZeroAcceleration,
+            }),
+            ..Request::default()
+        }
+    }
+}
+
+pub fn run(a: RunArgs) -> ExitCode {
+    let request = a.request();
+    if let Some(bad) = request.check().first() {
+        return usage(&bad.flag_message());
+    }
+    let (format, output) = (a.format, a.output.as_deref());
+    let text = match read(&a.model) {
+        Ok(t) => t,
+        Err(code) => return code,
+    };
+    let c =
+        match compile(&a.model, &text, &a.set, request, format).and_then(|c| runnable(c, format)) {
+            Ok(c) => c,
+            Err(code) => return code,
+        };
+    let mut sink = match sink(output) {
+        Ok(s) => s,
+        Err(code) => return code,
+    };
+    let started = std::time::Instant::now();
+    let mut progress = Steps::new(started);
+    let result = mbd::run_with_progress(&c, &mut sink, &mut |k, n| progress.update(k, n));
+    progress.finish();
+    match result {
+        Ok(r) => {
+            report(&r.warnings, &c.sources, format);
+            if format == Format::Human {
+                eprintln!(
+                    "{}: {} steps, {} Newton iterations, {} halvings, max |C| {:.2e} m, {} rows{} in {:.1} ms",
+                    c.model.name,
+                    r.stats.steps,
+                    r.stats.newton_iterations,
+                    r.stats.halvings,
+                    r.stats.max_constraint_violation,
+                    r.rows,
+                    to_path(output),
+                    started.elapsed().as_secs_f64() * 1e3
+                );
+            }
+            ExitCode::SUCCESS
+        }
+        Err(f) => {
+            report(&f.warnings, &c.sources, format);
+            report(std::slice::from_ref(&f.diagnostic), &c.sources, format);
+            if format == Format::Human {
+                eprintln!(
+                    "{} rows written before the failure{}",
+                    f.rows,
+                    to_path(output)
+                );
+            }
+            ExitCode::from(EXIT_RUNTIME)
+        }
+    }
+}
