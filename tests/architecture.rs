@@ -171,7 +171,6 @@ fn fn_name(rest: &str) -> Option<String> {
 }
 
 #[test]
-#[ignore = "enabled when issue 17's split lands"]
 fn no_file_is_past_600_lines_and_no_function_past_120() {
     let mut too_long = Vec::new();
     for dir in ["src", "tests", "benches"] {

@@ -4,7 +4,7 @@
 
 use super::progress::Steps;
 use super::{compile, read, report, runnable, sink, to_path, usage, Format, EXIT_RUNTIME};
-use clap::ValueEnum;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mbd::settings::{Method, Request, Rotations, Start};
 use std::process::ExitCode;
 
@@ -19,8 +19,8 @@ pub struct RunArgs {
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
     /// Time integrator.
-    #[arg(long, value_enum)]
-    integrator: Option<IntegratorArg>,
+    #[arg(long, value_parser = choice(&Method::FLAGS))]
+    integrator: Option<Method>,
     /// HHT alpha, in [-1/3, 0].
     #[arg(long, allow_negative_numbers = true)]
     alpha: Option<f64>,
@@ -28,8 +28,8 @@ pub struct RunArgs {
     #[arg(long)]
     rho_inf: Option<f64>,
     /// Rotation treatment: incremental (default) or conformal (the paper's).
-    #[arg(long, value_enum)]
-    rotations: Option<RotationsArg>,
+    #[arg(long, value_parser = choice(&Rotations::FLAGS))]
+    rotations: Option<Rotations>,
     /// Time step in seconds.
     #[arg(long, conflicts_with = "steps")]
     dt: Option<f64>,
@@ -43,57 +43,38 @@ pub struct RunArgs {
     #[arg(long)]
     every: Option<usize>,
     /// Initial accelerations: consistent (default) or zero (the paper's start).
-    #[arg(long, value_enum)]
-    start: Option<StartArg>,
+    #[arg(long, value_parser = choice(&Start::FLAGS))]
+    start: Option<Start>,
     /// Diagnostics format.
     #[arg(long, value_enum, default_value = "human")]
     format: Format,
 }
 
-#[derive(Clone, Copy, ValueEnum)]
-enum IntegratorArg {
-    Hht,
-    GeneralizedAlpha,
-    Fet,
-    Static,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum RotationsArg {
-    Incremental,
-    Conformal,
-}
-
-#[derive(Clone, Copy, ValueEnum)]
-enum StartArg {
-    Consistent,
-    Zero,
+/// A flag's parser for one of the settings' named options (`Method::FLAGS`, ...).
+fn choice<T: Copy + Send + Sync + 'static>(
+    table: &'static [(&'static str, T)],
+) -> impl TypedValueParser<Value = T> {
+    PossibleValuesParser::new(table.iter().map(|(name, _)| *name)).map(move |s| {
+        table
+            .iter()
+            .find(|(name, _)| *name == s)
+            .map_or(table[0].1, |(_, v)| *v)
+    })
 }
 
 impl RunArgs {
     /// What the flags ask of the solver (not yet checked).
     fn request(&self) -> Request {
         Request {
-            method: self.integrator.map(|i| match i {
-                IntegratorArg::Hht => Method::Hht,
-                IntegratorArg::GeneralizedAlpha => Method::GeneralizedAlpha,
-                IntegratorArg::Fet => Method::Fet,
-                IntegratorArg::Static => Method::Static,
-            }),
+            method: self.integrator,
             alpha: self.alpha,
             rho_inf: self.rho_inf,
-            rotations: self.rotations.map(|r| match r {
-                RotationsArg::Incremental => Rotations::Incremental,
-                RotationsArg::Conformal => Rotations::Conformal,
-            }),
+            rotations: self.rotations,
             dt: self.dt,
             steps: self.steps,
             until: self.until,
             every: self.every,
-            start: self.start.map(|s| match s {
-                StartArg::Consistent => Start::Consistent,
-                StartArg::Zero => Start::ZeroAcceleration,
-            }),
+            start: self.start,
             ..Request::default()
         }
     }

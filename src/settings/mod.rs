@@ -38,6 +38,14 @@ impl Method {
         ("static", Method::Static),
     ];
 
+    /// Every method, with its name on the command line (`--integrator generalized-alpha`).
+    pub const FLAGS: [(&'static str, Method); 4] = [
+        ("hht", Method::Hht),
+        ("generalized-alpha", Method::GeneralizedAlpha),
+        ("fet", Method::Fet),
+        ("static", Method::Static),
+    ];
+
     pub fn parse(name: &str) -> Option<Method> {
         Self::NAMES
             .iter()
@@ -59,6 +67,14 @@ pub enum Rotations {
     Conformal,
 }
 
+impl Rotations {
+    /// Every treatment, with its name in a `solve` block and on the command line.
+    pub const FLAGS: [(&'static str, Rotations); 2] = [
+        ("incremental", Rotations::Incremental),
+        ("conformal", Rotations::Conformal),
+    ];
+}
+
 /// How the first step starts.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -68,6 +84,15 @@ pub enum Start {
     Consistent,
     /// Zero accelerations and multipliers, as the paper did (its Fig. 8).
     ZeroAcceleration,
+}
+
+impl Start {
+    /// Every start, with its name on the command line (`--start zero`; in a `solve` block
+    /// `start = zero_acceleration`).
+    pub const FLAGS: [(&'static str, Start); 2] = [
+        ("consistent", Start::Consistent),
+        ("zero", Start::ZeroAcceleration),
+    ];
 }
 
 /// A closed range of a real setting, its default and how it is written in messages.
