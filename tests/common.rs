@@ -73,3 +73,37 @@ pub fn simulate_text_with(
         Some(f) => Err((trace, f.diagnostic.message)),
     }
 }
+
+/// Asserts `measured <= bound` (a NaN fails). With `MBD_BOUNDS=FILE` in the environment, each
+/// call appends `file:line<TAB>what<TAB>measured<TAB>bound` to FILE: the table from which every
+/// bound is set at about three times its measured value (written beside it).
+#[track_caller]
+pub fn within(what: &str, measured: f64, bound: f64) {
+    let at = std::panic::Location::caller();
+    record(at, what, measured, bound);
+    assert!(
+        measured <= bound,
+        "{what}: {measured:.3e} exceeds its bound {bound:.2e} ({at})"
+    );
+}
+
+/// Asserts `measured >= floor`, recorded as [`within`] records.
+#[track_caller]
+pub fn above(what: &str, measured: f64, floor: f64) {
+    let at = std::panic::Location::caller();
+    record(at, what, measured, floor);
+    assert!(
+        measured >= floor,
+        "{what}: {measured:.3e} is below its floor {floor:.2e} ({at})"
+    );
+}
+
+fn record(at: &std::panic::Location, what: &str, measured: f64, bound: f64) {
+    use std::io::Write;
+    if let Some(path) = std::env::var_os("MBD_BOUNDS") {
+        let line = format!("{}:{}\t{what}\t{measured:.3e}\t{bound:.3e}\n", at.file(), at.line());
+        if let Ok(mut f) = std::fs::OpenOptions::new().create(true).append(true).open(path) {
+            let _ = f.write_all(line.as_bytes());
+        }
+    }
+}
