@@ -2,6 +2,7 @@
 //! shooting solution of the elastica, modes against Euler-Bernoulli and the published rotating
 //! cantilever, and dynamics: the rotating beam (P1), the two-bar mechanism with beams (P3, P4).
 
+use crate::common::{above, within};
 use crate::common::{read, simulate, Trace};
 use crate::reference::dopri;
 use mbd::settings::Request;
@@ -34,11 +35,12 @@ fn cantilever_rolls_into_the_exact_arcs_and_a_full_circle() {
         worst = worst.max(((xs[k] - xe).powi(2) + (ys[k] - ye).powi(2) + zs[k].powi(2)).sqrt());
     }
     // 10 quadratic elements: measured 3.6e-6 m (the arc is interpolated by parabolas).
-    assert!(worst < 2e-5 * l, "largest tip error {worst:e} m");
+    within(&format!("largest tip error {worst:e} m"), worst, 2e-5 * l);
     let closed = (last(&t, "x").powi(2) + last(&t, "y").powi(2)).sqrt();
-    assert!(
-        closed < 1e-5 * l,
-        "the circle does not close: tip {closed:e} m from the root"
+    within(
+        &format!("the circle does not close: tip {closed:e} m from the root"),
+        closed,
+        1e-5 * l,
     );
 }
 
@@ -53,10 +55,10 @@ fn small_tip_force_gives_the_linear_deflection() {
     // Timoshenko: bending P L^3 / (3 EI) plus shear P L / GA (GA = 1e7 N, 3e-5 of the total).
     let exact = -p * l.powi(3) / (3.0 * ei) - p * l / 1e7;
     let rel = (last(&t, "z") - exact).abs() / exact.abs();
-    assert!(
-        rel < 1e-6,
-        "tip deflection {} vs {exact}: {rel:e}",
-        last(&t, "z")
+    within(
+        &format!("tip deflection {} vs {exact}: {rel:e}", last(&t, "z")),
+        rel,
+        1e-6,
     );
 }
 
@@ -138,7 +140,11 @@ fn cantilever_bending_frequencies_match_euler_bernoulli() {
         for pair in [w[2 * n], w[2 * n + 1]] {
             let rel = (pair - exact).abs() / exact;
             // Measured: 2e-9, 8e-5, 7e-4 (shear flexibility, 10 quadratic elements).
-            assert!(rel < 2e-3, "mode {}: {pair} vs {exact} ({rel:e})", n + 1);
+            within(
+                &format!("mode {}: {pair} vs {exact} ({rel:e})", n + 1),
+                rel,
+                2e-3,
+            );
         }
     }
 }
@@ -166,9 +172,10 @@ fn rotating_cantilever_flap_frequency_rises_with_spin_as_published() {
     for (wbar, exact) in [(0.0, 3.5160), (1.0, 3.6817), (2.0, 4.1373), (4.0, 5.5850)] {
         let w = modes_of("rotating", ROTATING, &[format!("Omega={}", 10.0 * wbar)]);
         let flap = w[0] * 0.1;
-        assert!(
-            (flap - exact).abs() < 2e-4 * exact,
-            "Omega-bar {wbar}: {flap} vs {exact}"
+        within(
+            &format!("Omega-bar {wbar}: {flap} vs {exact}"),
+            (flap - exact).abs(),
+            2e-4 * exact,
         );
         assert!(flap > previous);
         previous = flap;
@@ -192,7 +199,7 @@ fn rotating_beam_phase_error_falls_at_second_order() {
     }
     // Measured: -8.7e-3, -3.9e-3, -9.7e-4, -3.8e-5, -9.6e-6, -2.4e-6.
     for w in errors.windows(2) {
-        assert!(w[1].1.abs() < w[0].1.abs(), "{errors:?}");
+        within(&format!("{errors:?}"), w[1].1.abs(), w[0].1.abs());
     }
     let order =
         |a: (usize, f64), b: (usize, f64)| (a.1 / b.1).abs().ln() / (b.0 as f64 / a.0 as f64).ln();
@@ -205,7 +212,7 @@ fn rotating_beam_phase_error_falls_at_second_order() {
             errors[b].0
         );
     }
-    assert!(errors[5].1.abs() < 5e-6);
+    within("errors[5].1.abs()", errors[5].1.abs(), 5e-6);
 }
 
 #[test]
@@ -228,9 +235,13 @@ fn two_bar_beams_agree_with_the_rigid_two_bar() {
             .map(|(a, b)| (a - b).abs())
             .fold(0.0, f64::max)
     };
-    assert!(diff("theta2") < 1.5e-2, "theta2 {}", diff("theta2"));
+    within(
+        &format!("theta2 {}", diff("theta2")),
+        diff("theta2"),
+        1.5e-2,
+    );
     for c in ["xc2", "yc2", "zc2"] {
-        assert!(diff(c) < 3e-3, "{c} {}", diff(c));
+        within(&format!("{c} {}", diff(c)), diff(c), 3e-3);
     }
 }
 
@@ -254,7 +265,7 @@ fn two_bar_beams_runs_the_papers_case_at_its_step() {
     let (a, b) = (beams.col("theta2"), rigid.col("theta2"));
     let worst = (0..=200).map(|k| (a[k] - b[k]).abs()).fold(0.0, f64::max);
     eprintln!("two_bar_beams dt 0.05: theta2 within {worst:.3e} rad of the rigid model to 10 s");
-    assert!(worst < 0.2, "theta2 {worst}");
+    within(&format!("theta2 {worst}"), worst, 0.2);
 }
 
 #[test]
@@ -283,9 +294,9 @@ fn elastic_two_bar_root_torque_exceeds_the_rigid_one_and_converges() {
         peak(&b.col("torque")),
         peak(&c.col("torque")),
     );
-    assert!(pa / r0 > 2.0, "peak torque ratio {}", pa / r0);
-    assert!((pa - pb).abs() < 0.01 * pb, "dt: {pa} vs {pb}");
-    assert!((pa - pc).abs() < 0.03 * pc, "mesh: {pa} vs {pc}");
+    above(&format!("peak torque ratio {}", pa / r0), pa / r0, 2.0);
+    within(&format!("dt: {pa} vs {pb}"), (pa - pb).abs(), 0.01 * pb);
+    within(&format!("mesh: {pa} vs {pc}"), (pa - pc).abs(), 0.03 * pc);
     // Elastic motion in the yz path of bar 2's centre of mass, small against the bar.
     let dev = a
         .col("yc2")

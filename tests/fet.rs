@@ -3,6 +3,7 @@
 //! for a free body (adaptive Dormand-Prince), the rotating beam's exact rigid rotation, the
 //! two-bar's reduced equations; and where the scheme fails, as THEORY §8.2 says it does.
 
+use crate::common::{above, within};
 use crate::common::{read, simulate, simulate_text};
 use crate::pendulum::{final_error, sawtooth, Reference};
 use crate::reference::{free_body, TwoBar};
@@ -71,12 +72,21 @@ fn fet_is_the_trapezoidal_rule_on_a_linear_oscillator_and_keeps_its_amplitude() 
     let hht_loss = 1.0 - hht.col("e").last().copied().unwrap_or(0.0) / 0.5;
     eprintln!("oscillator, 10,000 steps at omega h = 0.2: FET from the trapezoidal rule {worst:.3e} (of the amplitude), energy drift {drift:.3e}; HHT -0.1 energy loss {hht_loss:.3}");
     // Round-off of 10,000 steps: measured 2e-13.
-    assert!(
-        worst < 1e-10,
-        "FET departs from the trapezoidal rule by {worst:.3e}"
+    within(
+        &format!("FET departs from the trapezoidal rule by {worst:.3e}"),
+        worst,
+        1e-10,
     );
-    assert!(drift < 1e-12, "FET changes the energy by {drift:.3e}");
-    assert!(hht_loss > 0.2, "HHT -0.1 should dissipate, lost {hht_loss}");
+    within(
+        &format!("FET changes the energy by {drift:.3e}"),
+        drift,
+        1e-12,
+    );
+    above(
+        &format!("HHT -0.1 should dissipate, lost {hht_loss}"),
+        hht_loss,
+        0.2,
+    );
 }
 
 /// The pendulum's position at 1 s converges at second order (errors against the RK4
@@ -102,7 +112,7 @@ fn fet_is_second_order_on_the_pendulum() {
     eprintln!("pendulum FET errors at 1 s: {errs:?}; observed order {p:.3}");
     assert!((1.9..=2.1).contains(&p), "observed order {p}");
     // The paper's accuracy at its step (0.02 % after 200 steps).
-    assert!(errs[1] < 2e-4, "error at dt = 0.005: {}", errs[1]);
+    within(&format!("error at dt = 0.005: {}", errs[1]), errs[1], 2e-4);
 }
 
 /// A torque-free asymmetric body: the orientation at 10 s converges at second order against
@@ -154,9 +164,9 @@ fn fet_is_second_order_on_a_free_body_and_keeps_its_angular_momentum() {
             .map(|x| (x - energy[0]).abs() / energy[0])
             .fold(0.0, f64::max);
         eprintln!("free body FET dt {dt}: rotation error {e:.3e} rad, angular momentum drift {dh:.3e}, energy error {de:.3e}");
-        assert!(dh < 1e-10, "angular momentum drifts by {dh:.3e}");
+        within(&format!("angular momentum drifts by {dh:.3e}"), dh, 1e-10);
         // Bounded, O(h^2): measured 1.2e-4 at dt = 0.02 (omega h ~ 0.025).
-        assert!(de < 1e-3, "energy error {de:.3e}");
+        within(&format!("energy error {de:.3e}"), de, 1e-3);
         errs.push(e);
     }
     for w in errs.windows(2) {
@@ -190,7 +200,7 @@ fn fet_is_second_order_on_the_rotating_beam() {
         assert!((1.9..=2.1).contains(&p), "order {p:.3} (errors {errs:?})");
     }
     // 360 steps: measured 2.6e-5 (HHT -0.1: 9.6e-6).
-    assert!(errs[2] < 5e-5, "error at 360 steps {}", errs[2]);
+    within(&format!("error at 360 steps {}", errs[2]), errs[2], 5e-5);
 }
 
 /// P3, the rigid two-bar, at the paper's step: bar 2's centre of mass follows the reduced
@@ -209,7 +219,7 @@ fn fet_follows_the_two_bar_reduced_equations() {
     let errs: Vec<f64> = [0.05, 0.025, 0.0125].map(error).to_vec();
     eprintln!("two-bar FET, t <= 10 s: max centre-of-mass errors {errs:?} m");
     // HHT -0.1 at dt = 0.05: 2.7e-2 m (rigid.rs).
-    assert!(errs[0] < 3.5e-2, "{errs:?}");
+    within(&format!("{errs:?}"), errs[0], 3.5e-2);
     for w in errs.windows(2) {
         let p = order(w[0], w[1]);
         assert!((1.8..=2.3).contains(&p), "order {p:.3} (errors {errs:?})");
@@ -238,14 +248,16 @@ fn fet_keeps_the_oscillation_a_kinked_drive_excites_and_hht_damps_it() {
     let (f_kink, f_late) = (sawtooth(&f, 206..240), sawtooth(&f, 360..398));
     let (h_kink, h_late) = (sawtooth(&h, 206..240), sawtooth(&h, 360..398));
     eprintln!("drive-torque sawtooth after the kink / at the end: FET {f_kink:.3e} / {f_late:.3e} N m, HHT -0.1 {h_kink:.3e} / {h_late:.3e} N m");
-    assert!(f_kink > 1e-3, "the kink must excite FET: {f_kink}");
-    assert!(
-        f_late > 0.7 * f_kink,
-        "FET has no dissipation: {f_kink} -> {f_late}"
+    above(&format!("the kink must excite FET: {f_kink}"), f_kink, 1e-3);
+    above(
+        &format!("FET has no dissipation: {f_kink} -> {f_late}"),
+        f_late,
+        0.7 * f_kink,
     );
-    assert!(
-        h_late < 1e-4 * h_kink,
-        "HHT -0.1 damps it: {h_kink} -> {h_late}"
+    within(
+        &format!("HHT -0.1 damps it: {h_kink} -> {h_late}"),
+        h_late,
+        1e-4 * h_kink,
     );
 }
 
@@ -262,6 +274,6 @@ fn fet_on_stiff_beams_in_large_motion_fails_with_a_hint() {
     let t = tr.col("t");
     let reached = t.last().copied().unwrap_or(0.0);
     eprintln!("two_bar_beams under FET fails at {reached} s: {message}");
-    assert!(reached > 2.0, "fails early, at {reached} s");
+    above(&format!("fails early, at {reached} s"), reached, 2.0);
     assert!(message.contains("time element"), "{message}");
 }

@@ -5,6 +5,7 @@
 //! marker's body, at that marker's point, and `moment` the moment it applies on that body about
 //! that point; inertial components, or with `.in(MARKER)` components in that marker's axes.
 
+use crate::common::within;
 use crate::common::{simulate_text, Trace};
 use crate::modes::teetering;
 use mbd::settings::Request;
@@ -51,11 +52,11 @@ fn a_spinning_rods_root_loads_are_constant_in_the_hub_axes_from_the_first_row() 
         for (k, v) in t.col(col).iter().enumerate() {
             let err = (v - exact).abs() / 800.0;
             worst = worst.max(err);
-            assert!(err < 1e-9, "{col} row {k}: {v} vs {exact}");
+            within(&format!("{col} row {k}: {v} vs {exact}"), err, 1e-9);
         }
     }
     // Measured: 2e-12 of the centripetal force.
-    assert!(worst < 1e-9);
+    within("worst", worst, 1e-9);
     // In inertial axes the same force turns with the rod: at t the radial direction is
     // (cos Omega t, sin Omega t, 0). The first row is no exception.
     let (time, fx, fy) = (t.col("t"), t.col("f.x"), t.col("f.y"));
@@ -67,17 +68,16 @@ fn a_spinning_rods_root_loads_are_constant_in_the_hub_axes_from_the_first_row() 
         turned = turned.max(err);
         // The hub's angle is integrated from its prescribed rate, to the Newton tolerance per
         // step: measured 2.3e-10 of the force after 100 steps.
-        assert!(
-            err < 1e-9,
-            "row {k}: ({}, {}) vs ({ex}, {ey})",
-            fx[k],
-            fy[k]
+        within(
+            &format!("row {k}: ({}, {}) vs ({ex}, {ey})", fx[k], fy[k]),
+            err,
+            1e-9,
         );
     }
     assert!(turned > 0.0 || time.len() < 2);
     // The massless hub passes the rod's load on to the drive: the same force on the hub.
     for (d, f) in t.col("drive.x").iter().zip(t.col("f.x")) {
-        assert!((d - f).abs() < 1e-7, "{d} vs {f}");
+        within(&format!("{d} vs {f}"), (d - f).abs(), 1e-7);
     }
 }
 
@@ -88,19 +88,19 @@ fn the_teetering_rotors_first_row_root_force_is_the_centripetal_one() {
     let (m, omega, rc) = (8.0, 31.4, 0.2 + 1.0);
     let exact = -m * omega * omega * rc;
     let x = t.col("root0.x");
-    assert!(
-        (x[0] - exact).abs() < 1e-12 * exact.abs(),
-        "first row {} vs {exact}",
-        x[0]
+    within(
+        &format!("first row {} vs {exact}", x[0]),
+        (x[0] - exact).abs(),
+        1e-12 * exact.abs(),
     );
     // After the start, the Newton tolerance leaves noise: measured 2.5e-7 of the force along
     // the blade and 2.1e-3 N across it over 200 steps (bounded: the same over 3 s).
     let worst = x.iter().fold(0.0f64, |a, v| a.max((v - exact).abs())) / exact.abs();
-    assert!(worst < 1e-6, "{worst:e}");
+    within(&format!("{worst:e}"), worst, 1e-6);
     for c in ["root0.y", "root0.z"] {
         let across = t.col(c).iter().fold(0.0f64, |a, v| a.max(v.abs()));
-        assert!(across < 6e-3, "{c}: {across}");
+        within(&format!("{c}: {across}"), across, 6e-3);
     }
     let beta = t.col("beta").iter().fold(0.0f64, |a, v| a.max(v.abs()));
-    assert!(beta < 1e-9, "teeter angle {beta}");
+    within(&format!("teeter angle {beta}"), beta, 1e-9);
 }

@@ -1,6 +1,7 @@
 //! Every shipped model and stdlib module passes `mbd check`; the validation models expose the
 //! params and channels PROBLEMS.md fixes, and build the geometry and initial state it states.
 
+use crate::common::within;
 use crate::common::{read, repo};
 use mbd::diagnostics::render_human;
 use mbd::model::{Drive, JointKind, Model};
@@ -211,7 +212,7 @@ fn windmill_builds_n_blades_spinning_about_the_hub() {
                     b.velocity
                 );
                 assert!(close(b.angular_velocity, [0.0, 0.0, omega], 1e-12));
-                assert!((b.mass - 20.0).abs() < 1e-12);
+                within("(b.mass - 20.0).abs()", (b.mass - 20.0).abs(), 1e-12);
                 // Slender rod: inertia m L^2 / 12 across, none along.
                 let axial = (0..3)
                     .map(|i| {
@@ -264,7 +265,11 @@ fn windmill_builds_n_blades_spinning_about_the_hub() {
             } else {
                 let mast = &m.beams[0];
                 let h: f64 = 3.6;
-                assert!((mast.section.stiffness[4][4] - k_t * h.powi(3) / 12.0).abs() < 1e-9 * k_t);
+                within(
+                    "(mast.section.stiffness[4][4] - k_t * h.powi(3) / 12.0).abs()",
+                    (mast.section.stiffness[4][4] - k_t * h.powi(3) / 12.0).abs(),
+                    1e-9 * k_t,
+                );
                 assert!(
                     close(mast.nodes[mast.nodes.len() - 1], [0.0, 0.0, 0.0], 1e-12),
                     "the mast's top carries the hub"
@@ -280,7 +285,11 @@ fn windmill_builds_n_blades_spinning_about_the_hub() {
                 JointKind::Revolute {
                     drive: Drive::Rate { f },
                     ..
-                } => assert!((f.eval(1.0) - omega).abs() < 1e-12),
+                } => within(
+                    "(f.eval(1.0) - omega).abs()",
+                    (f.eval(1.0) - omega).abs(),
+                    1e-12,
+                ),
                 k => panic!("{k:?}"),
             }
         }
@@ -303,8 +312,16 @@ fn spinup_drives_the_hub_with_a_ramped_torque() {
             ..
         } => {
             assert_eq!(t.eval(0.0), 0.0);
-            assert!((t.eval(0.25) - 250.0).abs() < 1e-9);
-            assert!((t.eval(3.0) - 500.0).abs() < 1e-9);
+            within(
+                "(t.eval(0.25) - 250.0).abs()",
+                (t.eval(0.25) - 250.0).abs(),
+                1e-9,
+            );
+            within(
+                "(t.eval(3.0) - 500.0).abs()",
+                (t.eval(3.0) - 500.0).abs(),
+                1e-9,
+            );
         }
         k => panic!("{k:?}"),
     }
@@ -315,7 +332,11 @@ fn spinup_drives_the_hub_with_a_ramped_torque() {
         .find(|b| b.name == "rotor.hub_body")
         .expect("hub");
     assert_eq!(hub.mass, 0.0);
-    assert!((hub.angular_velocity[2] - 9.26).abs() < 1e-12);
+    within(
+        "(hub.angular_velocity[2] - 9.26).abs()",
+        (hub.angular_velocity[2] - 9.26).abs(),
+        1e-12,
+    );
 }
 
 #[test]
@@ -335,8 +356,16 @@ fn two_bar_places_bar_two_by_its_initial_angle() {
         assert!(close(bar2.position, center, 1e-12), "{:?}", bar2.position);
         let load = &c.model.loads[0];
         // F = F0 <t>: 0.1 N/s * t up to 10 s, then down to 0 at 20 s.
-        assert!((load.value[1].eval(5.0) - 0.5).abs() < 1e-12);
-        assert!((load.value[1].eval(15.0) - 0.5).abs() < 1e-12);
+        within(
+            "(load.value[1].eval(5.0) - 0.5).abs()",
+            (load.value[1].eval(5.0) - 0.5).abs(),
+            1e-12,
+        );
+        within(
+            "(load.value[1].eval(15.0) - 0.5).abs()",
+            (load.value[1].eval(15.0) - 0.5).abs(),
+            1e-12,
+        );
         assert_eq!(load.value[1].eval(30.0), 0.0);
     }
     let c = compile("models/two_bar_spin.mbd", &[]);
@@ -364,13 +393,18 @@ fn rotating_beam_starts_in_the_stretched_state() {
         for (k, x) in beam.initial_nodes.iter().enumerate() {
             let s = beam.nodes[k][0];
             let u = (b * s).sin() / (b * (b * l).cos()) - s;
-            assert!(
-                (x[0] - s - u).abs() < 1e-15 * l.max(1.0) + 1e-15,
-                "node {k}"
+            within(
+                &format!("node {k}"),
+                (x[0] - s - u).abs(),
+                1e-15 * l.max(1.0) + 1e-15,
             );
             assert!(close(beam.velocities[k], [0.0, omega * x[0], 0.0], 1e-9));
         }
-        assert!((c.settings.until - std::f64::consts::PI / omega).abs() < 1e-16);
+        within(
+            "(c.settings.until - std::f64::consts::PI / omega).abs()",
+            (c.settings.until - std::f64::consts::PI / omega).abs(),
+            1e-16,
+        );
     }
 }
 

@@ -6,6 +6,7 @@
 //! inertia biased the start's multipliers, and with them every spinning rod's frequencies.
 
 use crate::cli::{code, mbd, stderr, temp};
+use crate::common::within;
 use mbd::diagnostics::Code;
 use mbd::settings::Request;
 use mbd::solve::modes::{Frame, Modes};
@@ -111,9 +112,10 @@ fn hinged_rods_and_rigid_blades_match_the_closed_forms_at_every_speed() {
                     for wi in w {
                         let err = (wi - exact).abs() / exact.max(1.0);
                         worst = worst.max(err);
-                        assert!(
-                            err < 1e-9,
-                            "e {e}, k {k}, Omega {omega}: {wi} vs {exact} rad/s"
+                        within(
+                            &format!("e {e}, k {k}, Omega {omega}: {wi} vs {exact} rad/s"),
+                            err,
+                            1e-9,
                         );
                     }
                 }
@@ -121,7 +123,7 @@ fn hinged_rods_and_rigid_blades_match_the_closed_forms_at_every_speed() {
         }
     }
     // Measured: 3.4e-11 (round-off of the start and the QZ).
-    assert!(worst < 1e-10, "{worst:e}");
+    within(&format!("{worst:e}"), worst, 1e-10);
 }
 
 #[test]
@@ -130,7 +132,11 @@ fn the_issue_s_two_cases_give_the_textbook_frequencies() {
     // before the fix); two rods on lag hinges offset 0.3 m: 9.969 (19.796 before).
     let flap = omegas("flap", &rotor(Body::Rod, Hinge::Flap, 1, 0.0, 100.0, 20.0));
     assert_eq!(flap.len(), 1);
-    assert!((flap[0] - 20.233_017_570_300_9).abs() < 1e-9, "{flap:?}");
+    within(
+        &format!("{flap:?}"),
+        (flap[0] - 20.233_017_570_300_9).abs(),
+        1e-9,
+    );
     let lag = omegas("lag", &rotor(Body::Rod, Hinge::Lag, 2, 0.3, 100.0, 20.0));
     assert!(
         lag.iter().all(|w| (w - 9.968_701_018_7).abs() < 1e-8),
@@ -150,7 +156,7 @@ fn rods_and_equivalent_rigid_bodies_have_the_same_modes() {
             assert_eq!(a.len(), b.len());
             for (x, y) in a.iter().zip(&b) {
                 // Measured: up to 7.9e-12.
-                assert!((x - y).abs() < 2.5e-11 * x, "{a:?} vs {b:?}");
+                within(&format!("{a:?} vs {b:?}"), (x - y).abs(), 2.5e-11 * x);
             }
         }
     }
@@ -171,7 +177,11 @@ solve hht { dt = 1 ms, until = 1 s }
     assert_eq!((m.modes.len(), m.dofs), (1, 1));
     let exact = (3.0 * 9.81 / (2.0 * 1.5f64)).sqrt();
     // Measured: 1.9e-11.
-    assert!((m.modes[0].omega() - exact).abs() < 6e-11 * exact);
+    within(
+        "(m.modes[0].omega() - exact).abs()",
+        (m.modes[0].omega() - exact).abs(),
+        6e-11 * exact,
+    );
     // Welded to the ground: no degree of freedom, no mode, no failure.
     let welded = text.replace(
         "revolute(earth, bar.start) { axis = z }",
@@ -213,7 +223,7 @@ fn spinning_cantilever_flap_and_lag_follow_southwell() {
         den += w * phi * phi;
     }
     let southwell = num / den;
-    assert!((southwell - 1.1933).abs() < 1e-4, "{southwell}");
+    within(&format!("{southwell}"), (southwell - 1.1933).abs(), 1e-4);
     let model = |omega: f64| {
         format!(
             "model spinning \"A cantilever on a hub driven at Omega\"
@@ -234,7 +244,7 @@ solve hht {{ dt = 1 ms, until = 1 s }}
     // the second flap mode.
     let w0 = omegas("still", &model(0.0));
     let (flap0, lag0) = (w0[0], w0[1]);
-    assert!((lag0 / flap0 - 2.0).abs() < 1e-4, "{w0:?}");
+    within(&format!("{w0:?}"), (lag0 / flap0 - 2.0).abs(), 1e-4);
     let mut errors = Vec::new();
     for omega in [5.0, 10.0] {
         let w = omegas("spinning", &model(omega));
@@ -287,18 +297,18 @@ fn a_blade_coned_by_gravity_is_analysed_about_its_steady_coning_angle() {
     let m = modes_of("coning", &text, false).expect("modes");
     assert!(matches!(m.frame, Frame::Rotating { .. }));
     // Measured: 1.9e-12.
-    assert!(
-        (m.modes[0].omega() - exact).abs() < 6e-12 * exact,
-        "{} vs {exact}",
-        m.modes[0].omega()
+    within(
+        &format!("{} vs {exact}", m.modes[0].omega()),
+        (m.modes[0].omega() - exact).abs(),
+        6e-12 * exact,
     );
     // The rod's centre moved from the flat start by L/2 (1 - cos b0) in and L/2 sin b0 down.
     let tip = 0.5 * L * ((1.0 - b0.cos()).powi(2) + b0.sin().powi(2)).sqrt();
     // Measured: 2e-16 m.
-    assert!(
-        (m.moved - tip).abs() < 1e-12 * tip,
-        "moved {} vs {tip}",
-        m.moved
+    within(
+        &format!("moved {} vs {tip}", m.moved),
+        (m.moved - tip).abs(),
+        1e-12 * tip,
     );
 }
 
@@ -361,10 +371,10 @@ fn models_without_a_steady_motion_are_refused_with_e0605_or_frozen_on_request() 
     let it = 2.0 * 8.0 * (2.2f64.powi(3) - 0.2f64.powi(3)) / (3.0 * 2.0);
     let exact = (31.4f64 * 31.4 + 50.0 / it).sqrt();
     // Measured: 8e-14.
-    assert!(
-        (m.modes[0].omega() - exact).abs() < 3e-13 * exact,
-        "{} vs {exact}",
-        m.modes[0].omega()
+    within(
+        &format!("{} vs {exact}", m.modes[0].omega()),
+        (m.modes[0].omega() - exact).abs(),
+        3e-13 * exact,
     );
     // The windmill (a rotor on a slider tower) and a pendulum swinging through the bottom.
     let windmill = crate::common::read("models/windmill.mbd");
@@ -466,11 +476,23 @@ fn a_fan_plot_follows_the_flap_mode_against_the_rotor_speed() {
     for (k, r) in rows.iter().enumerate() {
         let omega = k as f64 * 100.0 * std::f64::consts::TAU / 60.0;
         let num = |i: usize| r[i].parse::<f64>().unwrap_or(f64::NAN);
-        assert!((num(0) - omega).abs() < 1e-12 * omega.max(1.0));
+        within(
+            "(num(0) - omega).abs()",
+            (num(0) - omega).abs(),
+            1e-12 * omega.max(1.0),
+        );
         assert_eq!(r[1], "1");
         let exact = closed_form(Hinge::Flap, 0.3, 100.0, omega);
-        assert!((num(3) - exact).abs() < 1e-9 * exact, "{r:?} vs {exact}");
-        assert!((num(8) - omega).abs() < 1e-9 * omega.max(1.0));
+        within(
+            &format!("{r:?} vs {exact}"),
+            (num(3) - exact).abs(),
+            1e-9 * exact,
+        );
+        within(
+            "(num(8) - omega).abs()",
+            (num(8) - omega).abs(),
+            1e-9 * omega.max(1.0),
+        );
     }
     let chart = std::fs::read_to_string(&svg).expect("svg");
     assert!(

@@ -3,6 +3,7 @@
 //! centre of mass of a floating assembly of every kind of mass, and the diagnostics of bad
 //! calls.
 
+use crate::common::{above, within};
 use crate::common::{read, simulate, simulate_text, Trace};
 use mbd::diagnostics::Code;
 use mbd::settings::Request;
@@ -76,21 +77,25 @@ fn windmill_multiblade_columns_are_the_coleman_transform_of_the_lag_angles() {
         // The pulse must have set the blades lagging, or the check would be vacuous.
         let largest = zeta.iter().flatten().fold(0.0f64, |m, z| m.max(z.abs()));
         let cyclic = cols[1].iter().fold(0.0f64, |m, z| m.max(z.abs()));
-        assert!(
-            largest > 5e-5,
-            "N = {n}: the blades barely move ({largest})"
+        above(
+            &format!("N = {n}: the blades barely move ({largest})"),
+            largest,
+            5e-5,
         );
-        assert!(cyclic > 5e-5, "N = {n}: no cyclic lag ({cyclic})");
+        above(&format!("N = {n}: no cyclic lag ({cyclic})"), cyclic, 5e-5);
         for (r, &time) in t.iter().enumerate() {
             // The drive is prescribed at the rate Omega from angle 0.
             let psi = OMEGA * time;
             let z: Vec<f64> = zeta.iter().map(|c| c[r]).collect();
             for (j, &(suffix, harmonic, kind)) in coords.iter().enumerate() {
                 let want = coleman(&z, psi, harmonic, kind);
-                assert!(
-                    (cols[j][r] - want).abs() <= 1e-12,
-                    "N = {n}, t = {time}: zeta_{suffix} = {} but the transform gives {want}",
-                    cols[j][r]
+                within(
+                    &format!(
+                        "N = {n}, t = {time}: zeta_{suffix} = {} but the transform gives {want}",
+                        cols[j][r]
+                    ),
+                    (cols[j][r] - want).abs(),
+                    1e-12,
                 );
             }
             // The inverse transform gives the blade angles back.
@@ -110,9 +115,10 @@ fn windmill_multiblade_columns_are_the_coleman_transform_of_the_lag_angles() {
                             }
                     })
                     .sum();
-                assert!(
-                    (back - zk).abs() <= 1e-12,
-                    "N = {n}, t = {time}: blade {k} is {zk}, the inverse gives {back}"
+                within(
+                    &format!("N = {n}, t = {time}: blade {k} is {zk}, the inverse gives {back}"),
+                    (back - zk).abs(),
+                    1e-12,
                 );
             }
         }
@@ -149,18 +155,24 @@ fn windmill_center_of_mass_follows_the_hub_and_the_blades() {
             }
             let want = [x_hub[r] + x / n as f64, y / n as f64, 0.0];
             for c in 0..3 {
-                assert!(
-                    (cm[c][r] - want[c]).abs() <= 1e-9,
-                    "N = {n}, t = {time}: rotor_cm[{c}] = {} but the blades put it at {}",
-                    cm[c][r],
-                    want[c]
+                within(
+                    &format!(
+                        "N = {n}, t = {time}: rotor_cm[{c}] = {} but the blades put it at {}",
+                        cm[c][r], want[c]
+                    ),
+                    (cm[c][r] - want[c]).abs(),
+                    1e-9,
                 );
             }
             off_hub = off_hub.max((cm[0][r] - x_hub[r]).hypot(cm[1][r]));
         }
         // The cyclic lag moves the centre off the hub (the paper's Fig. 22), by 6e-5 to 8e-5 m
         // in this half second.
-        assert!(off_hub > 3e-5, "N = {n}: the centre never leaves the hub");
+        above(
+            &format!("N = {n}: the centre never leaves the hub"),
+            off_hub,
+            3e-5,
+        );
     }
 }
 
@@ -241,23 +253,30 @@ fn center_of_mass_weighs_bodies_beams_and_concentrated_masses() {
         .collect();
     let row = &trace.rows[0];
     for k in 0..3 {
-        assert!(
-            (row[1 + k] - want[k]).abs() < 1e-12,
-            "cm[{k}] = {} vs {}",
-            row[1 + k],
-            want[k]
+        within(
+            &format!("cm[{k}] = {} vs {}", row[1 + k], want[k]),
+            (row[1 + k] - want[k]).abs(),
+            1e-12,
         );
     }
-    assert!((row[10] - plate[0]).abs() < 1e-15);
+    within(
+        "(row[10] - plate[0]).abs()",
+        (row[10] - plate[0]).abs(),
+        1e-15,
+    );
     let tail_y = (m_tail * tail[1]) / (m_tail + m_lump);
-    assert!((row[11] - tail_y).abs() < 1e-12, "{} vs {tail_y}", row[11]);
+    within(
+        &format!("{} vs {tail_y}", row[11]),
+        (row[11] - tail_y).abs(),
+        1e-12,
+    );
     // Spun as a whole about z at 2 rad/s: the centre moves with w x r.
     let v0 = [-2.0 * want[1], 2.0 * want[0], 0.0];
     for k in 0..3 {
-        assert!(
-            (row[4 + k] - v0[k]).abs() < 1e-12,
-            "v[{k}] = {}",
-            row[4 + k]
+        within(
+            &format!("v[{k}] = {}", row[4 + k]),
+            (row[4 + k] - v0[k]).abs(),
+            1e-12,
         );
     }
     // Nothing pushes the assembly: its centre keeps that velocity and does not accelerate,
@@ -267,24 +286,21 @@ fn center_of_mass_weighs_bodies_beams_and_concentrated_masses() {
     let speed = (v0[0] * v0[0] + v0[1] * v0[1]).sqrt();
     for row in &trace.rows {
         for k in 0..3 {
-            assert!(
-                (row[4 + k] - v0[k]).abs() < 1e-6 * speed,
-                "t = {}: v[{k}] = {}",
-                row[0],
-                row[4 + k]
+            within(
+                &format!("t = {}: v[{k}] = {}", row[0], row[4 + k]),
+                (row[4 + k] - v0[k]).abs(),
+                1e-6 * speed,
             );
-            assert!(
-                row[7 + k].abs() < 1e-8,
-                "t = {}: a[{k}] = {}",
-                row[0],
-                row[7 + k]
+            within(
+                &format!("t = {}: a[{k}] = {}", row[0], row[7 + k]),
+                row[7 + k].abs(),
+                1e-8,
             );
             let x = want[k] + v0[k] * row[0];
-            assert!(
-                (row[1 + k] - x).abs() < 1e-8,
-                "t = {}: cm[{k}] = {} vs {x}",
-                row[0],
-                row[1 + k]
+            within(
+                &format!("t = {}: cm[{k}] = {} vs {x}", row[0], row[1 + k]),
+                (row[1 + k] - x).abs(),
+                1e-8,
             );
         }
     }

@@ -3,6 +3,7 @@
 //! a step of at most 1e-5 s (global error below 1e-12 rad), itself checked against the exact
 //! elliptic-function solution.
 
+use crate::common::{above, within};
 use crate::common::{simulate, Trace};
 use mbd::settings::{Request, Start};
 
@@ -107,10 +108,10 @@ fn reference_integrator_matches_the_elliptic_solution() {
     for step in (0..=200).step_by(10) {
         let t = step as f64 * 0.005;
         let exact = 2.0 * (k * jacobi_sn(w0 * t, k)).asin();
-        assert!(
-            (r.theta[step] - exact).abs() < 1e-10,
-            "t = {t}: rk4 {} exact {exact}",
-            r.theta[step]
+        within(
+            &format!("t = {t}: rk4 {} exact {exact}", r.theta[step]),
+            (r.theta[step] - exact).abs(),
+            1e-10,
         );
     }
 }
@@ -126,22 +127,27 @@ fn pendulum_matches_the_exact_solution_to_the_papers_accuracy() {
         final_error(&trace, &r)
     );
     // The paper: within 0.02 % of L over the whole second.
-    assert!(err < 2e-4, "position error {err:.3e} L exceeds 0.02 %");
+    within(
+        &format!("position error {err:.3e} L exceeds 0.02 %"),
+        err,
+        2e-4,
+    );
     let tension = trace.col("tension");
     let t0 = r.tension(0);
-    assert!(
-        (tension[0] - 14.31).abs() < 1e-9,
-        "initial tension {}",
-        tension[0]
+    within(
+        &format!("initial tension {}", tension[0]),
+        (tension[0] - 14.31).abs(),
+        1e-9,
     );
     let terr = (0..tension.len())
         .map(|k| (tension[k] - r.tension(k)).abs())
         .fold(0.0, f64::max)
         / t0;
     eprintln!("pendulum dt=0.005 alpha=-0.1: max tension error {terr:.3e} of T(0)");
-    assert!(
-        terr < 5e-3,
-        "tension error {terr:.3e} of its initial value exceeds 0.5 %"
+    within(
+        &format!("tension error {terr:.3e} of its initial value exceeds 0.5 %"),
+        terr,
+        5e-3,
     );
 }
 
@@ -195,19 +201,22 @@ fn paper_start_oscillates_at_alpha_zero_and_is_damped_at_alpha_minus_0_1() {
     let (u_first, u_last) = (sawtooth(&undamped, 2..22), sawtooth(&undamped, 178..198));
     let (d_first, d_last) = (sawtooth(&damped, 2..22), sawtooth(&damped, 178..198));
     eprintln!("Fig. 8 sawtooth in ax [m/s^2]: alpha=0 first {u_first:.3e} last {u_last:.3e}; alpha=-0.1 first {d_first:.3e} last {d_last:.3e}");
-    assert!(
-        u_first > 0.5,
-        "the inconsistent start must excite a sawtooth, got {u_first}"
+    above(
+        &format!("the inconsistent start must excite a sawtooth, got {u_first}"),
+        u_first,
+        0.5,
     );
-    assert!(
-        u_last > 0.5 * u_first,
-        "at alpha = 0 the sawtooth persists: {u_first} -> {u_last}"
+    above(
+        &format!("at alpha = 0 the sawtooth persists: {u_first} -> {u_last}"),
+        u_last,
+        0.5 * u_first,
     );
-    assert!(
-        d_last < 1e-2 * d_first,
-        "at alpha = -0.1 the sawtooth is damped out: {d_first} -> {d_last}"
+    within(
+        &format!("at alpha = -0.1 the sawtooth is damped out: {d_first} -> {d_last}"),
+        d_last,
+        1e-2 * d_first,
     );
-    assert!(u_last > 100.0 * d_last);
+    above("u_last", u_last, 100.0 * d_last);
 }
 
 #[test]
@@ -220,11 +229,12 @@ fn consistent_start_has_no_sawtooth_at_any_alpha() {
         // What remains is the scheme's own O(h^2) acceleration error of the index-3 form
         // (persistent at alpha = 0) and its O(h) start-up error, damped when alpha < 0
         // (Arnold & Bruls 2007): at most 0.5 % of the paper-start sawtooth.
-        assert!(whole < 5e-3, "alpha = {alpha}: sawtooth {whole}");
+        within(&format!("alpha = {alpha}: sawtooth {whole}"), whole, 5e-3);
         if alpha < 0.0 {
-            assert!(
-                late < 1e-4,
-                "alpha = {alpha}: the start-up transient is damped out, {late}"
+            within(
+                &format!("alpha = {alpha}: the start-up transient is damped out, {late}"),
+                late,
+                1e-4,
             );
         }
     }
@@ -245,9 +255,10 @@ fn constraint_holds_to_the_newton_tolerance_at_every_step() {
             .map(|(x, y)| (((x - E).powi(2) + y.powi(2)).sqrt() - L).abs())
             .fold(0.0, f64::max);
         // The Newton tolerance: 1e-10 of the model's length scale (L).
-        assert!(
-            worst <= 1e-10 * L,
-            "alpha {alpha}: |C| reached {worst:.3e} m"
+        within(
+            &format!("alpha {alpha}: |C| reached {worst:.3e} m"),
+            worst,
+            1e-10 * L,
         );
     }
 }
@@ -255,18 +266,23 @@ fn constraint_holds_to_the_newton_tolerance_at_every_step() {
 #[test]
 fn over_the_top_pendulum_stays_accurate() {
     let v0 = 5.0;
-    assert!(v0 * v0 > 4.0 * G * L);
+    above("v0 * v0", v0 * v0, 4.0 * G * L);
     let trace = run(0.005, -0.1, Start::Consistent, &["V0=5"]);
     let r = Reference::new(v0, 0.005, 200);
-    assert!(
-        r.theta[200] > 2.0 * std::f64::consts::PI,
-        "the reference goes over the top"
+    above(
+        "the reference goes over the top",
+        r.theta[200],
+        2.0 * std::f64::consts::PI,
     );
     let err = position_error(&trace, &r);
     eprintln!("over the top V0=5 m/s: max position error {err:.3e} L");
     // About ten radians a second: at omega*h = 0.05 the phase error of a second-order scheme
     // is of order 1e-2 rad after one second.
-    assert!(err < 1e-2, "over-the-top position error {err:.3e} L");
+    within(
+        &format!("over-the-top position error {err:.3e} L"),
+        err,
+        1e-2,
+    );
     let fine = run(0.00125, -0.1, Start::Consistent, &["V0=5m/s"]);
     let err_fine = position_error(&fine, &Reference::new(v0, 0.00125, 800));
     let order = (err / err_fine).log2() / 2.0;
@@ -285,7 +301,7 @@ fn set_accepts_si_numbers_and_values_with_units() {
     assert_eq!(a.rows, b.rows);
     for (ra, rc) in a.rows.iter().zip(&c.rows) {
         for (x, y) in ra.iter().zip(rc) {
-            assert!((x - y).abs() <= 1e-12 * (1.0 + x.abs()));
+            within("(x - y).abs()", (x - y).abs(), 1e-12 * (1.0 + x.abs()));
         }
     }
     assert_eq!(a.col("vx")[0], 3.0);
@@ -318,7 +334,11 @@ fn newton_converges_in_two_solves_per_step() {
         stats.newton_iterations,
         stats.steps
     );
-    assert!(stats.max_constraint_violation <= 1e-10 * L);
+    within(
+        "stats.max_constraint_violation",
+        stats.max_constraint_violation,
+        1e-10 * L,
+    );
 }
 
 #[test]
@@ -337,5 +357,5 @@ fn halved_steps_recover_and_stay_accurate() {
         "rows stay on the requested step grid"
     );
     let err = position_error(&trace, &Reference::new(5.0, 0.005, 200));
-    assert!(err < 1e-2, "position error {err:.3e} L");
+    within(&format!("position error {err:.3e} L"), err, 1e-2);
 }

@@ -1,7 +1,8 @@
 //! Robustness: thousands of mutated versions of the shipped models and stdlib modules (tokens
 //! deleted, duplicated, swapped, files truncated, random bytes spliced in) go through the
 //! compiler. It must never panic or hang: every input compiles or is reported with a
-//! diagnostic, and `mbd check` exits 0 or 1.
+//! diagnostic, `mbd check` exits 0 or 1 within a wall-clock limit, and a mutant that checks
+//! runs a few steps or fails with a reported error.
 
 use crate::common::{read, repo};
 use mbd::settings::Request;
@@ -141,45 +142,60 @@ fn corpus() -> Vec<(String, String)> {
     out
 }
 
-#[test]
-fn mutated_models_never_panic() {
-    let corpus = corpus();
-    let mut rng = Lcg(0x5eed_1234);
-    let mut compiled = 0;
-    let mut rejected = 0;
-    let per_file = 8000 / corpus.len();
-    for (name, text) in &corpus {
-        for k in 0..per_file {
-            let input = mutate(text, &mut rng);
-            let started = std::time::Instant::now();
-            let result = std::panic::catch_unwind(|| {
-                if mbd::is_library(&input) {
-                    mbd::check_library(name, &input, &mbd::model::NoFiles).is_ok()
-                } else {
-                    let ok = mbd::compile(name, &input, &[], Request::default());
-                    match ok {
-                        // Every rejection carries at least one error diagnostic.
-                        Err(f) => {
-                            assert!(
-                                f.diagnostics.iter().any(|d| d.is_error()),
-                                "rejected without an error"
-                            );
-                            false
-                        }
-                        Ok(_) => true,
-                    }
-                }
-            });
-            match result {
-                Ok(true) => compiled += 1,
-                Ok(false) => rejected += 1,
-                Err(_) => panic!("the compiler panicked on mutation {k} of {name}:\n{input}"),
-            }
-            let took = started.elapsed();
+/// Compiles one mutant in-process: `Ok(true)` compiled, `Ok(false)` rejected with an error.
+fn compile_mutant(name: &str, input: &str) -> bool {
+    if mbd::is_library(input) {
+        return mbd::check_library(name, input, &mbd::model::NoFiles).is_ok();
+    }
+    match mbd::compile(name, input, &[], Request::default()) {
+        // Every rejection carries at least one error diagnostic.
+        Err(f) => {
             assert!(
-                took.as_secs_f64() < 5.0,
-                "mutation {k} of {name} took {took:?}:\n{input}"
+                f.diagnostics.iter().any(|d| d.is_error()),
+                "rejected without an error"
             );
+            false
+        }
+        Ok(_) => true,
+    }
+}
+
+/// The compiler on 8,000 mutants in-process (fast), on a worker thread watched by this one: a
+/// mutant that takes more than 10 s (a hang, or a cost out of all proportion: the largest
+/// model compiles in milliseconds) fails the test with its text.
+#[test]
+fn mutated_models_never_panic_or_hang() {
+    use std::sync::mpsc;
+    use std::sync::{Arc, Mutex};
+    let current = Arc::new(Mutex::new(String::new()));
+    let (tx, rx) = mpsc::channel::<Result<bool, String>>();
+    let watched = Arc::clone(&current);
+    std::thread::spawn(move || {
+        let corpus = corpus();
+        let mut rng = Lcg(0x5eed_1234);
+        let per_file = 8000 / corpus.len();
+        for (name, text) in &corpus {
+            for k in 0..per_file {
+                let input = mutate(text, &mut rng);
+                *watched.lock().expect("lock") = format!("mutation {k} of {name}:\n{input}");
+                let result = std::panic::catch_unwind(|| compile_mutant(name, &input))
+                    .map_err(|_| format!("the compiler panicked on mutation {k} of {name}:\n{input}"));
+                if tx.send(result).is_err() {
+                    return;
+                }
+            }
+        }
+    });
+    let (mut compiled, mut rejected) = (0, 0);
+    loop {
+        match rx.recv_timeout(std::time::Duration::from_secs(10)) {
+            Ok(Ok(true)) => compiled += 1,
+            Ok(Ok(false)) => rejected += 1,
+            Ok(Err(panicked)) => panic!("{panicked}"),
+            Err(mpsc::RecvTimeoutError::Disconnected) => break,
+            Err(mpsc::RecvTimeoutError::Timeout) => {
+                panic!("no answer within 10 s on {}", current.lock().expect("lock"))
+            }
         }
     }
     assert!(compiled + rejected >= 7000, "{compiled} + {rejected}");
@@ -190,29 +206,81 @@ fn mutated_models_never_panic() {
     );
 }
 
+/// Runs the binary with a wall-clock limit; `None` if it had to be killed.
+fn run_limited(args: &[&std::ffi::OsStr], limit: std::time::Duration) -> Option<std::process::Output> {
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mbd"))
+        .args(args)
+        .env("NO_COLOR", "1")
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("mbd runs");
+    let started = std::time::Instant::now();
+    loop {
+        if child.try_wait().expect("wait").is_some() {
+            return Some(child.wait_with_output().expect("output"));
+        }
+        if started.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            return None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}
+
+/// Mutants through the binary, each under a wall-clock limit: `mbd check` exits 0 or 1 within
+/// 10 s, and a model that checks runs 3 steps (`--steps 3`: the whole run in three large steps)
+/// and exits 0, 1 (an error only lowering finds, such as E0501) or 3 (a run-time failure,
+/// reported) within 30 s: never a panic (101), a signal, or a hang.
 #[test]
-fn mutated_models_exit_zero_or_one() {
+fn mutated_models_exit_zero_or_one_and_run_or_fail_cleanly() {
+    use std::ffi::OsStr;
+    use std::time::Duration;
     let corpus = corpus();
     let mut rng = Lcg(0xfeed_beef);
     let dir = std::env::temp_dir().join(format!("mbd-fuzz-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
+    let out = dir.join("out.csv");
+    let (mut ran, mut checked) = (0, 0);
     for (name, text) in &corpus {
-        for k in 0..6 {
+        for k in 0..16 {
             let input = mutate(text, &mut rng);
             let path = dir.join(format!("m{k}.mbd"));
             std::fs::write(&path, &input).expect("write");
-            let o = std::process::Command::new(env!("CARGO_BIN_EXE_mbd"))
-                .arg("check")
-                .arg(&path)
-                .output()
-                .expect("mbd runs");
+            let check = [OsStr::new("check"), path.as_os_str()];
+            let o = run_limited(&check, Duration::from_secs(10))
+                .unwrap_or_else(|| panic!("mbd check hung on a mutation of {name}:\n{input}"));
             let code = o.status.code();
             assert!(
                 code == Some(0) || code == Some(1),
                 "mbd check exited {code:?} on a mutation of {name}:\n{input}\n{}",
                 String::from_utf8_lossy(&o.stderr)
             );
+            checked += 1;
+            if code != Some(0) || mbd::is_library(&input) {
+                continue;
+            }
+            let run = [
+                OsStr::new("run"),
+                path.as_os_str(),
+                OsStr::new("--steps"),
+                OsStr::new("3"),
+                OsStr::new("-o"),
+                out.as_os_str(),
+            ];
+            let o = run_limited(&run, Duration::from_secs(30))
+                .unwrap_or_else(|| panic!("mbd run hung on a mutation of {name}:\n{input}"));
+            let code = o.status.code();
+            assert!(
+                matches!(code, Some(0) | Some(1) | Some(3)),
+                "mbd run exited {code:?} on a mutation of {name}:\n{input}\n{}",
+                String::from_utf8_lossy(&o.stderr)
+            );
+            ran += 1;
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
+    // Both paths must be exercised, or the test proves little.
+    assert!(checked == 16 * corpus.len() && ran >= 10, "checked {checked}, ran {ran}");
 }

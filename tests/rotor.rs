@@ -3,6 +3,7 @@
 //! in `reference/windmill.rs`); the spin-up's lag stability and its angular-momentum balance;
 //! and the convergence of the elastic-blade windmill in mesh and time step.
 
+use crate::common::{above, within};
 use crate::common::{read, simulate, simulate_text_with, Trace};
 use crate::reference::windmill::{windmill_reference, E, IB, MB, OMEGA_T, SB};
 use mbd::settings::Request;
@@ -79,10 +80,13 @@ fn windmill_errors(blades: usize, omega_bar: f64, dt: Option<f64>) -> Vec<(Strin
 fn assert_windmill(blades: usize, omega_bar: f64) -> f64 {
     let errors = windmill_errors(blades, omega_bar, None);
     for (name, e) in &errors {
-        assert!(
-            *e < 0.02,
-            "{blades} blades, Omega_bar {omega_bar}: {name} off by {:.3} % of its peak",
-            100.0 * e
+        within(
+            &format!(
+                "{blades} blades, Omega_bar {omega_bar}: {name} off by {:.3} % of its peak",
+                100.0 * e
+            ),
+            *e,
+            0.02,
         );
     }
     errors.iter().map(|(_, e)| *e).fold(0.0, f64::max)
@@ -103,7 +107,7 @@ fn windmill_reference_is_converged() {
         let b: Vec<f64> = fine.iter().map(|y| y[c]).collect();
         let e = rel_error(&a, &b);
         eprintln!("windmill reference, channel {c}: rtol 1e-9 against 1e-11 {e:.3e} of the peak");
-        assert!(e < 1e-8, "channel {c}: {e:.3e}");
+        within(&format!("channel {c}: {e:.3e}"), e, 1e-8);
     }
 }
 
@@ -130,7 +134,7 @@ fn windmill_unstable_rotor_follows_the_nonlinear_equations() {
         .fold(0.0, f64::max);
     let p = (coarse / fine).log2();
     eprintln!("windmill, Omega_bar 2: observed order {p:.2} between dt 1 ms and 0.5 ms");
-    assert!(p > 1.7, "order {p:.2} ({coarse:.3e}, {fine:.3e})");
+    above(&format!("order {p:.2} ({coarse:.3e}, {fine:.3e})"), p, 1.7);
 }
 
 /// Three and five blades at Omega_bar = 2, each against the equations with its own N (and
@@ -317,9 +321,10 @@ fn check_momentum(s: &Spin, t0: f64) -> (f64, f64) {
         s.momentum(0),
         residual / h_end
     );
-    assert!(
-        residual < 2e-6 * h_end,
-        "T0 {t0}: angular-momentum balance off by {residual:.3e} N m s of {h_end:.3e}"
+    within(
+        &format!("T0 {t0}: angular-momentum balance off by {residual:.3e} N m s of {h_end:.3e}"),
+        residual,
+        2e-6 * h_end,
     );
     // The rotor speed follows the impulse over the polar inertia (mb e^2 + 2 e Sb + Ib per blade,
     // 266.4 kg m^2): the hub's rate swings with the collective lag (the hub is massless), so
@@ -336,9 +341,10 @@ fn check_momentum(s: &Spin, t0: f64) -> (f64, f64) {
         "spin-up T0 {t0} N m: mean rotor speed over [4, 4.5] s {measured:.3} rad/s, \
          (H0 + impulse) / J {predicted:.3} rad/s"
     );
-    assert!(
-        (measured / predicted - 1.0).abs() < 0.01,
-        "T0 {t0}: rotor speed {measured:.3} rad/s, impulse predicts {predicted:.3}"
+    within(
+        &format!("T0 {t0}: rotor speed {measured:.3} rad/s, impulse predicts {predicted:.3}"),
+        (measured / predicted - 1.0).abs(),
+        0.01,
     );
     (residual, correction)
 }
@@ -360,25 +366,28 @@ fn check_momentum(s: &Spin, t0: f64) -> (f64, f64) {
 fn spinup_high_torque_crosses_the_band_without_instability() {
     let s = spin(2500.0, None);
     let (cyclic, differential) = lag_growth(&s, 2500.0);
-    assert!(cyclic < 3.5, "cyclic lag grew {cyclic:.2}-fold");
-    assert!(
-        differential < 3.5,
-        "zeta1 - zeta3 grew {differential:.2}-fold"
+    within(&format!("cyclic lag grew {cyclic:.2}-fold"), cyclic, 3.5);
+    within(
+        &format!("zeta1 - zeta3 grew {differential:.2}-fold"),
+        differential,
+        3.5,
     );
     let (prev, late) = (s.window(2.5, 3.5).0, s.window(3.5, 4.5 + 1e-9).0);
     eprintln!("spin-up T0 2500 N m: cyclic lag max [2.5, 3.5) {prev:.3e}, [3.5, 4.5] {late:.3e}");
-    assert!(
-        late < 1.05 * prev,
-        "the cyclic lag still grows: {prev:.3e} then {late:.3e}"
+    within(
+        &format!("the cyclic lag still grows: {prev:.3e} then {late:.3e}"),
+        late,
+        1.05 * prev,
     );
     let (coarse, _) = check_momentum(&s, 2500.0);
     let half = spin(2500.0, Some(2.5e-4));
     let (fine, _) = check_momentum(&half, 2500.0);
     let p = (coarse / fine).log2();
     eprintln!("spin-up T0 2500 N m: balance residual {coarse:.3e} at 0.5 ms, {fine:.3e} at 0.25 ms: order {p:.2}");
-    assert!(
-        p > 1.7,
-        "the balance residual does not converge: order {p:.2}"
+    above(
+        &format!("the balance residual does not converge: order {p:.2}"),
+        p,
+        1.7,
     );
 }
 
@@ -392,15 +401,21 @@ fn spinup_high_torque_crosses_the_band_without_instability() {
 fn spinup_low_torque_excites_the_instability() {
     let s = spin(500.0, None);
     let (cyclic, differential) = lag_growth(&s, 500.0);
-    assert!(cyclic > 10.0, "cyclic lag grew only {cyclic:.2}-fold");
-    assert!(
-        differential > 10.0,
-        "zeta1 - zeta3 grew only {differential:.2}-fold"
+    above(
+        &format!("cyclic lag grew only {cyclic:.2}-fold"),
+        cyclic,
+        10.0,
+    );
+    above(
+        &format!("zeta1 - zeta3 grew only {differential:.2}-fold"),
+        differential,
+        10.0,
     );
     let (residual, correction) = check_momentum(&s, 500.0);
-    assert!(
-        residual < 0.1 * correction,
-        "residual {residual:.3e} against a correction of {correction:.3e}"
+    within(
+        &format!("residual {residual:.3e} against a correction of {correction:.3e}"),
+        residual,
+        0.1 * correction,
     );
 }
 
@@ -464,7 +479,7 @@ fn elastic_windmill_converges_in_dt() {
             "elastic windmill {name}, dt 0.5 / 0.25 / 0.125 ms: differences {:.3e}, {:.3e} of the peak, order {p:.2}",
             d[c][0], d[c][1]
         );
-        assert!((p - 2.0).abs() < 0.3, "{name}: order {p:.2}");
+        within(&format!("{name}: order {p:.2}"), (p - 2.0).abs(), 0.3);
     }
 }
 
@@ -482,9 +497,10 @@ fn elastic_windmill_converges_in_mesh() {
             "elastic windmill {name}, 2 / 4 / 8 elements: differences {:.3e}, {:.3e} of the peak, ratio {ratio:.2}",
             d[c][0], d[c][1]
         );
-        assert!(
-            ratio > 3.0,
-            "{name}: mesh differences shrink only {ratio:.2}-fold"
+        above(
+            &format!("{name}: mesh differences shrink only {ratio:.2}-fold"),
+            ratio,
+            3.0,
         );
     }
 }

@@ -3,6 +3,7 @@
 
 use crate::cli::{code, mbd, stderr, temp};
 use crate::common::read;
+use crate::common::within;
 use crate::mbc::{mbc_edge, mbc_growth, mbc_roots};
 use mbd::settings::Request;
 use mbd::study::sweep::{self, Method, Point, Sweep, SweepSpec};
@@ -63,15 +64,27 @@ fn floquet_finds_the_ground_resonance_band_of_the_multiblade_equations() {
     assert_eq!(s.edges.len(), 2, "{:?}", s.edges);
     assert!(s.edges[0].onset && !s.edges[1].onset);
     for (e, want) in s.edges.iter().zip([1.1774, 2.3186]) {
-        assert!((e.value - want).abs() < 0.02, "edge {} vs {want}", e.value);
-        assert!(e.bracket.1 - e.bracket.0 < 0.0063, "{:?}", e.bracket);
+        within(
+            &format!("edge {} vs {want}", e.value),
+            (e.value - want).abs(),
+            0.02,
+        );
+        within(
+            &format!("{:?}", e.bracket),
+            e.bracket.1 - e.bracket.0,
+            0.0063,
+        );
     }
     // Against the test's own edges, to the bracket.
     assert!((s.edges[0].value - lo).abs() < 0.004 && (s.edges[1].value - hi).abs() < 0.004);
     assert_eq!(s.unstable_ranges().len(), 1);
     // Outside the band every exponent is neutral: no numerical growth beyond 1e-4 1/s.
     for p in s.points.iter().filter(|p| p.value < 1.1 || p.value > 2.4) {
-        assert!(p.max_real().abs() < 1e-4, "{}: {}", p.value, p.max_real());
+        within(
+            &format!("{}: {}", p.value, p.max_real()),
+            p.max_real().abs(),
+            1e-4,
+        );
     }
 }
 
@@ -128,10 +141,18 @@ fn growth_rates_match_the_multiblade_eigenvalues_for_3_4_and_5_blades() {
                 im.abs(),
                 rel
             );
-            assert!(rel < 0.02, "N = {blades} at {}: {got} vs {want}", p.value);
+            within(
+                &format!("N = {blades} at {}: {got} vs {want}", p.value),
+                rel,
+                0.02,
+            );
             let top = p.modes[0];
             match p.method {
-                Method::Prony => assert!((top.im - im.abs()).abs() < 0.01 * im.abs()),
+                Method::Prony => within(
+                    "(top.im - im.abs()).abs()",
+                    (top.im - im.abs()).abs(),
+                    0.01 * im.abs(),
+                ),
                 Method::Floquet => {
                     // Known modulo Omega: the distance of the frequencies to a multiple of it.
                     let omega = p.value * OMEGA_T;
@@ -139,10 +160,10 @@ fn growth_rates_match_the_multiblade_eigenvalues_for_3_4_and_5_blades() {
                         .iter()
                         .map(|x| (x / omega - (x / omega).round()).abs() * omega)
                         .fold(f64::INFINITY, f64::min);
-                    assert!(
-                        d < 0.01 * im.abs(),
-                        "frequency {} vs {im} mod {omega}",
-                        top.im
+                    within(
+                        &format!("frequency {} vs {im} mod {omega}", top.im),
+                        d,
+                        0.01 * im.abs(),
                     );
                 }
             }
@@ -162,9 +183,9 @@ fn prony_finds_the_neutral_modes_of_the_stable_rotor() {
             .iter()
             .find(|m| (m.im - want).abs() < 2e-3)
             .unwrap_or_else(|| panic!("no mode at {want} rad/s: {:?}", p.modes));
-        assert!(m.re.abs() < 1e-4, "{m:?}");
+        within(&format!("{m:?}"), m.re.abs(), 1e-4);
     }
-    assert!(p.max_real().abs() < 1e-4);
+    within("p.max_real().abs()", p.max_real().abs(), 1e-4);
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! onsets; bad usage.
 
 use crate::cli::{code, mbd, stderr, temp};
+use crate::common::{above, within};
 use std::process::Output;
 
 fn stdout(o: &Output) -> String {
@@ -74,7 +75,11 @@ fn pendulum_convergence_study_is_second_order_for_every_integrator() {
         let errors: Vec<f64> = runs.iter().map(|r| number(&r[3])).collect();
         for (r, steps) in runs.iter().zip(["100", "200", "400", "800"]) {
             assert_eq!((r[0].as_str(), r[2].as_str()), (*integrator, steps));
-            assert!((number(&r[1]) - 1.0 / number(steps)).abs() < 1e-15);
+            within(
+                "(number(&r[1]) - 1.0 / number(steps)).abs()",
+                (number(&r[1]) - 1.0 / number(steps)).abs(),
+                1e-15,
+            );
             assert!(number(&r[4]) > 0.0 && number(&r[5]) >= number(steps));
         }
         assert!(
@@ -158,10 +163,10 @@ fn exact_reference_gives_the_rotating_beams_relative_angle_error() {
         let pi = std::f64::consts::PI;
         let want = (last - pi).abs() / pi;
         let got = number(&row[3]);
-        assert!(
-            (got - want).abs() <= 1e-12 * want,
-            "{} steps: study error {got}, from the run {want}",
-            row[2]
+        within(
+            &format!("{} steps: study error {got}, from the run {want}", row[2]),
+            (got - want).abs(),
+            1e-12 * want,
         );
     }
     assert!(stdout(&o).contains("reference: the exact solution of phi"));
@@ -232,7 +237,7 @@ fn two_bar_stability_study_finds_the_onset_without_dissipation_only() {
         ("hht", "0.0", "1000")
     );
     let onset = number(&zero[4]);
-    assert!(onset > 5.0, "onset at {onset} s\n{text}");
+    above(&format!("onset at {onset} s\n{text}"), onset, 5.0);
     assert!(text.contains("alpha = 0: onset at "), "{text}");
     if !zero[5].is_empty() {
         assert!(
@@ -243,7 +248,7 @@ fn two_bar_stability_study_finds_the_onset_without_dissipation_only() {
     // alpha = -0.1: bounded through the 50 s of the run.
     assert_eq!(damped[1], "-0.1");
     assert_eq!((damped[4].as_str(), damped[5].as_str()), ("", ""), "{text}");
-    assert!(number(&damped[7]) > 1000.0);
+    above("number(&damped[7])", number(&damped[7]), 1000.0);
     assert!(
         text.contains("alpha = -0.1: no growth through 50 s"),
         "{text}"
@@ -338,7 +343,7 @@ fn failed_runs_keep_their_rows_and_do_not_stop_the_study() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let (_, rows) = cells(&csv);
     assert_eq!(rows.len(), 2);
-    assert!(number(&rows[0][3]) > 0.0, "{:?}", rows[0]);
+    above(&format!("{:?}", rows[0]), number(&rows[0][3]), 0.0);
     assert_eq!(rows[1][0], "hht:0");
     assert_eq!(
         (

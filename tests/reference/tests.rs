@@ -2,6 +2,7 @@
 //! conventions and invariants stated in `mod.rs`.
 
 use super::*;
+use crate::common::{above, within};
 use std::f64::consts::{FRAC_PI_2, PI};
 
 fn linspace(a: f64, b: f64, n: usize) -> Vec<f64> {
@@ -89,10 +90,10 @@ fn dopri_matches_exponential_and_hits_requested_times() {
     for (t, y) in times.iter().zip(&ys) {
         // rtol 1e-12 per step, a few hundred steps: global relative error well under 1e-10.
         let exact = (-t).exp();
-        assert!(
-            (y[0] - exact).abs() <= 1e-10 * exact,
-            "t = {t}: {} vs {exact}",
-            y[0]
+        within(
+            &format!("t = {t}: {} vs {exact}", y[0]),
+            (y[0] - exact).abs(),
+            1e-10 * exact,
         );
     }
 }
@@ -117,9 +118,10 @@ fn dopri_error_follows_the_tolerance() {
     };
     let (coarse, fine) = (err(1e-6), err(1e-11));
     assert!(coarse < 1e-4 && fine < 1e-9, "coarse {coarse}, fine {fine}");
-    assert!(
-        coarse / fine > 1e3,
-        "error did not shrink with rtol: {coarse} -> {fine}"
+    above(
+        &format!("error did not shrink with rtol: {coarse} -> {fine}"),
+        coarse / fine,
+        1e3,
     );
 }
 
@@ -130,9 +132,13 @@ fn dopri_steps_exactly_onto_breaks() {
     // Without the break the same run is visibly worse (> 1e-14).
     let f = |t: f64, _y: &[f64; 1]| [(t - 1.0).abs()];
     let with = dopri_breaks(f, 0.0, [0.0], &[2.0], &[1.0, 7.0, -3.0], 1e-6, 1e-8)[0][0];
-    assert!((with - 1.0).abs() < 1e-14, "with break: {with}");
+    within(&format!("with break: {with}"), (with - 1.0).abs(), 1e-14);
     let without = dopri(f, 0.0, [0.0], &[2.0], 1e-6, 1e-8)[0][0];
-    assert!((without - 1.0).abs() > 1e-14, "without break: {without}");
+    above(
+        &format!("without break: {without}"),
+        (without - 1.0).abs(),
+        1e-14,
+    );
 }
 
 // --- two-bar -----------------------------------------------------------------------------
@@ -171,10 +177,15 @@ fn two_bar_kinetic_energy_and_momentum_match_the_bar_kinematics() {
         }
         let t_formula = tb.kinetic_energy(th2, th1d, th2d);
         let h_formula = tb.momentum_z(th2, th1d, th2d);
-        assert!((t - t_formula).abs() < 1e-13 * t, "T: {t} vs {t_formula}");
-        assert!(
-            (hz - h_formula).abs() < 1e-13 * t.sqrt(),
-            "Hz: {hz} vs {h_formula}"
+        within(
+            &format!("T: {t} vs {t_formula}"),
+            (t - t_formula).abs(),
+            1e-13 * t,
+        );
+        within(
+            &format!("Hz: {hz} vs {h_formula}"),
+            (hz - h_formula).abs(),
+            1e-13 * t.sqrt(),
         );
     }
 }
@@ -186,23 +197,32 @@ fn two_bar_sign_conventions() {
     let s = tb.state(0.0, [0.4, 0.0, 0.0], [FRAC_PI_2, 0.0, 0.0], 0.0);
     let e1 = [0.4f64.cos(), 0.4f64.sin(), 0.0];
     let want = [0.5 * e1[0], 0.5 * e1[1], 0.25];
-    assert!(dist(s.xc, want) < 1e-15, "{:?}", s.xc);
+    within(&format!("{:?}", s.xc), dist(s.xc, want), 1e-15);
     // th2 right-handed about e1: n = Rot(e1, th2) (z x e1), to 1e-15.
     let e2 = cross([0.0, 0.0, 1.0], e1);
     for th2 in [0.3, 2.0, -1.0] {
         let s = tb.state(0.0, [0.4, 0.0, 0.0], [th2, 0.0, 0.0], 0.0);
         let n: [f64; 3] = std::array::from_fn(|i| (s.xc[i] - 0.5 * e1[i]) / 0.25);
-        assert!(
-            dist(n, mat_vec(&rodrigues(e1, th2), e2)) < 1e-15,
-            "th2 = {th2}"
+        within(
+            &format!("th2 = {th2}"),
+            dist(n, mat_vec(&rodrigues(e1, th2), e2)),
+            1e-15,
         );
     }
     // A positive force along +y at th1 = 0 accelerates th1 positively (junction along e2 =
     // +y); a positive torque T spins bar 2 positively about e1. Both from rest.
     let tb_f = TwoBar { t0: 0.0, ..tb };
-    assert!(tb_f.accelerations(1.0, 0.0, 0.0, 0.0, 0.0).0 > 0.0);
+    above(
+        "tb_f.accelerations(1.0, 0.0, 0.0, 0.0, 0.0).0",
+        tb_f.accelerations(1.0, 0.0, 0.0, 0.0, 0.0).0,
+        0.0,
+    );
     let tb_t = TwoBar { f0: 0.0, ..tb };
-    assert!(tb_t.accelerations(1.0, 0.0, 0.0, 0.0, 0.0).1 > 0.0);
+    above(
+        "tb_t.accelerations(1.0, 0.0, 0.0, 0.0, 0.0).1",
+        tb_t.accelerations(1.0, 0.0, 0.0, 0.0, 0.0).1,
+        0.0,
+    );
 }
 
 #[test]
@@ -237,8 +257,8 @@ fn two_bar_kinematics_match_finite_differences_of_an_analytic_path() {
             })
         };
         let p = path(t);
-        assert!(dist(d(&|s| s.xc), p.vc) < 1e-9, "vc at t = {t}");
-        assert!(dist(d(&|s| s.vc), p.ac) < 1e-9, "ac at t = {t}");
+        within(&format!("vc at t = {t}"), dist(d(&|s| s.xc), p.vc), 1e-9);
+        within(&format!("ac at t = {t}"), dist(d(&|s| s.vc), p.ac), 1e-9);
     }
 }
 
@@ -299,10 +319,14 @@ fn two_bar_unloaded_conserves_energy_and_momentum() {
             .map(|s| tb.kinetic_energy(s.th2, s.th1d, s.th2d) - e0),
     ) / e0;
     let dh = max_abs(s.iter().map(|s| tb.momentum_z(s.th2, s.th1d, s.th2d) - h0)) / h0.abs();
-    assert!(de < 1e-9, "energy drift {de}");
-    assert!(dh < 1e-9, "momentum drift {dh}");
+    within(&format!("energy drift {de}"), de, 1e-9);
+    within(&format!("momentum drift {dh}"), dh, 1e-9);
     // Not trivially constant: bar 2 really moves and exchanges energy with bar 1.
-    assert!(max_abs(s.iter().map(|x| x.th1d - s[0].th1d)) > 1e-2);
+    above(
+        "max_abs(s.iter().map(|x| x.th1d - s[0].th1d))",
+        max_abs(s.iter().map(|x| x.th1d - s[0].th1d)),
+        1e-2,
+    );
 }
 
 #[test]
@@ -315,10 +339,10 @@ fn two_bar_case1_work_energy_balance() {
     let run = tb.case1_with_work(0.0, FRAC_PI_2, 0.0, 0.0, &times);
     for (s, w) in &run {
         let t = tb.kinetic_energy(s.th2, s.th1d, s.th2d);
-        assert!(
-            (t - w).abs() < 1e-7 * t.max(1.0),
-            "t = {}: T = {t}, W = {w}",
-            s.t
+        within(
+            &format!("t = {}: T = {t}, W = {w}", s.t),
+            (t - w).abs(),
+            1e-7 * t.max(1.0),
         );
     }
     let tb_t = TwoBar { f0: 0.0, ..tb };
@@ -328,7 +352,11 @@ fn two_bar_case1_work_energy_balance() {
         s.iter()
             .map(|s| tb_t.momentum_z(s.th2, s.th1d, s.th2d) - h0),
     ) / h0.abs();
-    assert!(dh < 1e-9, "momentum drift under internal torque {dh}");
+    within(
+        &format!("momentum drift under internal torque {dh}"),
+        dh,
+        1e-9,
+    );
 }
 
 #[test]
@@ -352,7 +380,7 @@ fn two_bar_case1_matches_the_papers_description() {
             .iter()
             .map(|s| tb.kinetic_energy(s.th2, s.th1d, s.th2d) - e20),
     ) / e20;
-    assert!(de < 1e-9, "energy drift after the loads end {de}");
+    within(&format!("energy drift after the loads end {de}"), de, 1e-9);
 }
 
 #[test]
@@ -364,32 +392,39 @@ fn two_bar_case2_impulsive_start_and_first_integral() {
     let tb = TwoBar::paper_case2();
     let omega = 0.5;
     let th2d0 = tb.impulsive_th2dot(omega, FRAC_PI_2);
-    assert!((th2d0 - 0.75).abs() < 1e-15, "impulsive start {th2d0}");
+    within(
+        &format!("impulsive start {th2d0}"),
+        (th2d0 - 0.75).abs(),
+        1e-15,
+    );
     let times = linspace(0.0, 50.0, 1000);
     let run = tb.case2_with_work(omega, FRAC_PI_2, th2d0, &times);
     let first = |s: &TwoBarState| s.th2d.powi(2) + (omega * s.th2.sin()).powi(2);
     let c = first(&run[0].0);
-    assert!((c - 0.8125).abs() < 1e-15);
+    within("(c - 0.8125).abs()", (c - 0.8125).abs(), 1e-15);
     for (s, w) in &run {
-        assert!(
-            (first(s) - c).abs() < 1e-10,
-            "t = {}: first integral {}",
-            s.t,
-            first(s) - c
+        within(
+            &format!("t = {}: first integral {}", s.t, first(s) - c),
+            (first(s) - c).abs(),
+            1e-10,
         );
         let exact = -0.5 * omega * omega * (2.0 * s.th2).sin();
         assert!((s.th2dd - exact).abs() < 1e-14 && s.th1dd == 0.0 && s.th1 == omega * s.t);
         // Drive power balances the kinetic energy (checks the torque's sign): 1e-9 J.
         let de =
             tb.kinetic_energy(s.th2, s.th1d, s.th2d) - tb.kinetic_energy(FRAC_PI_2, omega, th2d0);
-        assert!(
-            (de - w).abs() < 1e-9,
-            "t = {}: dT {de}, drive work {w}",
-            s.t
+        within(
+            &format!("t = {}: dT {de}, drive work {w}", s.t),
+            (de - w).abs(),
+            1e-9,
         );
     }
     // The torque is the residual of the first equation and really varies.
-    assert!(max_abs(run.iter().map(|(s, _)| s.torque)) > 1e-2);
+    above(
+        "max_abs(run.iter().map(|(s, _)| s.torque))",
+        max_abs(run.iter().map(|(s, _)| s.torque)),
+        1e-2,
+    );
 }
 
 #[test]
@@ -403,10 +438,10 @@ fn two_bar_case2_revolution_period_is_elliptic() {
     let c = th2d0 * th2d0 + omega * omega;
     let period = 4.0 * ellip_k(omega * omega / c) / c.sqrt();
     let s = tb.case2(omega, FRAC_PI_2, th2d0, &[period, 50.0]);
-    assert!(
-        (s[0].th2 - FRAC_PI_2 - 2.0 * PI).abs() < 1e-9,
-        "th2(P) - 2 pi - pi/2 = {}",
-        s[0].th2 - FRAC_PI_2 - 2.0 * PI
+    within(
+        &format!("th2(P) - 2 pi - pi/2 = {}", s[0].th2 - FRAC_PI_2 - 2.0 * PI),
+        (s[0].th2 - FRAC_PI_2 - 2.0 * PI).abs(),
+        1e-9,
     );
     let revs = (s[1].th2 - FRAC_PI_2) / (2.0 * PI);
     assert!((6.0..7.0).contains(&revs), "revolutions in 50 s: {revs}");
@@ -427,9 +462,21 @@ fn free_body_conserves_energy_and_momentum() {
     let norm = |v: [f64; 3]| v.iter().map(|c| c * c).sum::<f64>().sqrt();
     let (e0, h0) = (energy(w0), jw(w0));
     for (r, w) in &out {
-        assert!((energy(*w) - e0).abs() < 1e-11 * e0);
-        assert!((norm(jw(*w)) - norm(h0)).abs() < 1e-11 * norm(h0));
-        assert!(dist(mat_vec(r, jw(*w)), h0) < 1e-10 * norm(h0));
+        within(
+            "(energy(*w) - e0).abs()",
+            (energy(*w) - e0).abs(),
+            1e-11 * e0,
+        );
+        within(
+            "(norm(jw(*w)) - norm(h0)).abs()",
+            (norm(jw(*w)) - norm(h0)).abs(),
+            1e-11 * norm(h0),
+        );
+        within(
+            "dist(mat_vec(r, jw(*w)), h0)",
+            dist(mat_vec(r, jw(*w)), h0),
+            1e-10 * norm(h0),
+        );
     }
     assert_eq!(
         out[0].0,
@@ -453,14 +500,15 @@ fn free_body_matches_the_axisymmetric_closed_form() {
     for (t, (r, w)) in times.iter().zip(free_body([a, a, c], w0, &times)) {
         let (s, co) = (lambda * t).sin_cos();
         let w_exact = [w0[0] * co - w0[1] * s, w0[0] * s + w0[1] * co, w0[2]];
-        assert!(dist(w, w_exact) < 1e-10, "w at t = {t}");
+        within(&format!("w at t = {t}"), dist(w, w_exact), 1e-10);
         let r1 = rodrigues(h, hn / a * t);
         let r2 = rodrigues([0.0, 0.0, 1.0], -lambda * t);
         for k in 0..3 {
             let col = mat_vec(&r1, [r2[0][k], r2[1][k], r2[2][k]]);
-            assert!(
-                dist([r[0][k], r[1][k], r[2][k]], col) < 1e-10,
-                "R column {k} at t = {t}"
+            within(
+                &format!("R column {k} at t = {t}"),
+                dist([r[0][k], r[1][k], r[2][k]], col),
+                1e-10,
             );
         }
     }
@@ -476,13 +524,15 @@ fn pendulum_small_angle_limit() {
     let w0 = (g / l).sqrt();
     let times = linspace(0.0, 5.0, 100);
     for (t, (th, thd)) in times.iter().zip(pendulum(l, g, v0, &times)) {
-        assert!(
-            (th - v0 / l / w0 * (w0 * t).sin()).abs() < 1e-12,
-            "theta at t = {t}"
+        within(
+            &format!("theta at t = {t}"),
+            (th - v0 / l / w0 * (w0 * t).sin()).abs(),
+            1e-12,
         );
-        assert!(
-            (thd - v0 / l * (w0 * t).cos()).abs() < 1e-11,
-            "theta' at t = {t}"
+        within(
+            &format!("theta' at t = {t}"),
+            (thd - v0 / l * (w0 * t).cos()).abs(),
+            1e-11,
         );
     }
 }
@@ -493,13 +543,21 @@ fn pendulum_matches_the_elliptic_solution() {
     // over 1 s; the energy L^2 theta'^2/2 + g L (1 - cos theta) = V0^2/2 to 1e-11 relative.
     let (l, g, v0): (f64, f64, f64) = (0.5, 9.81, 1.5);
     let k = v0 / (2.0 * (g * l).sqrt());
-    assert!((k - 0.33864).abs() < 5e-6);
+    within("(k - 0.33864).abs()", (k - 0.33864).abs(), 5e-6);
     let w0 = (g / l).sqrt();
     let times = linspace(0.0, 1.0, 200);
     for (t, (th, thd)) in times.iter().zip(pendulum(l, g, v0, &times)) {
         let exact = 2.0 * (k * jacobi_sn(w0 * t, k)).asin();
-        assert!((th - exact).abs() < 1e-10, "t = {t}: {th} vs {exact}");
+        within(
+            &format!("t = {t}: {th} vs {exact}"),
+            (th - exact).abs(),
+            1e-10,
+        );
         let e = 0.5 * l * l * thd * thd + g * l * (1.0 - th.cos());
-        assert!((e - 0.5 * v0 * v0).abs() < 1e-11 * v0 * v0);
+        within(
+            "(e - 0.5 * v0 * v0).abs()",
+            (e - 0.5 * v0 * v0).abs(),
+            1e-11 * v0 * v0,
+        );
     }
 }
