@@ -58,8 +58,8 @@ fn small_tip_force_gives_the_linear_deflection() {
     within(
         &format!("tip deflection {} vs {exact}: {rel:e}", last(&t, "z")),
         rel,
-        1e-6,
-    );
+        4e-11,
+    ); // measured 1.1e-11
 }
 
 /// The elastica of a cantilever under a tip force of fixed direction, by shooting:
@@ -132,19 +132,18 @@ fn cantilever_bending_frequencies_match_euler_bernoulli() {
     // EI2 = EI3: the bending modes come in pairs; torsion has no inertia and the axial mode is
     // far above. Euler-Bernoulli: omega_n = (beta_n L)^2 sqrt(EI / (m L^4)).
     let w = modes_of("cantilever", &read("models/cantilever.mbd"), &[]);
-    for (n, bl) in [1.875_104_068_7, 4.694_091_133, 7.854_757_438]
-        .iter()
-        .enumerate()
-    {
+    // Bounds per mode, about 3 times the measured 2.1e-5, 6.2e-5 and 3.9e-4 (shear flexibility
+    // and the mesh: 10 quadratic elements).
+    let cases = [
+        (1.875_104_068_7, 6e-5),
+        (4.694_091_133, 2e-4),
+        (7.854_757_438, 1.2e-3),
+    ];
+    for (n, (bl, bound)) in cases.iter().enumerate() {
         let exact = bl * bl * (100.0f64 / 1.0).sqrt();
         for pair in [w[2 * n], w[2 * n + 1]] {
             let rel = (pair - exact).abs() / exact;
-            // Measured: 2e-9, 8e-5, 7e-4 (shear flexibility, 10 quadratic elements).
-            within(
-                &format!("mode {}: {pair} vs {exact} ({rel:e})", n + 1),
-                rel,
-                2e-3,
-            );
+            within(&format!("mode {}: {pair} vs {exact}", n + 1), rel, *bound);
         }
     }
 }
@@ -175,8 +174,8 @@ fn rotating_cantilever_flap_frequency_rises_with_spin_as_published() {
         within(
             &format!("Omega-bar {wbar}: {flap} vs {exact}"),
             (flap - exact).abs(),
-            2e-4 * exact,
-        );
+            5e-5 * exact,
+        ); // measured 1.5e-5 * exact
         assert!(flap > previous);
         previous = flap;
     }
@@ -295,7 +294,7 @@ fn elastic_two_bar_root_torque_exceeds_the_rigid_one_and_converges() {
         peak(&c.col("torque")),
     );
     above(&format!("peak torque ratio {}", pa / r0), pa / r0, 2.0);
-    within(&format!("dt: {pa} vs {pb}"), (pa - pb).abs(), 0.01 * pb);
+    within(&format!("dt: {pa} vs {pb}"), (pa - pb).abs(), 0.004 * pb); // measured 1.1e-3 * pb
     within(&format!("mesh: {pa} vs {pc}"), (pa - pc).abs(), 0.03 * pc);
     // Elastic motion in the yz path of bar 2's centre of mass, small against the bar.
     let dev = a

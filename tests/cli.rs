@@ -209,7 +209,7 @@ fn inconsistent_initial_velocity_is_projected_with_a_warning() {
     assert!(stderr(&o).contains("W0601"), "{}", stderr(&o));
     let (_, rows) = csv(&o);
     // Tangent to the circle about the pivot at the bottom: no vertical velocity left.
-    within(&format!("vy = {}", rows[0][4]), rows[0][4].abs(), 1e-12);
+    within(&format!("vy = {}", rows[0][4]), rows[0][4].abs(), 3e-17); // measured 6.9e-18
     assert_eq!(rows[0][3], 1.5, "the tangential velocity is untouched");
 }
 

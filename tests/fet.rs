@@ -75,13 +75,13 @@ fn fet_is_the_trapezoidal_rule_on_a_linear_oscillator_and_keeps_its_amplitude() 
     within(
         &format!("FET departs from the trapezoidal rule by {worst:.3e}"),
         worst,
-        1e-10,
-    );
+        4e-13,
+    ); // measured 1.1e-13
     within(
         &format!("FET changes the energy by {drift:.3e}"),
         drift,
-        1e-12,
-    );
+        1.5e-13,
+    ); // measured 3.9e-14
     above(
         &format!("HHT -0.1 should dissipate, lost {hht_loss}"),
         hht_loss,
@@ -164,9 +164,9 @@ fn fet_is_second_order_on_a_free_body_and_keeps_its_angular_momentum() {
             .map(|x| (x - energy[0]).abs() / energy[0])
             .fold(0.0, f64::max);
         eprintln!("free body FET dt {dt}: rotation error {e:.3e} rad, angular momentum drift {dh:.3e}, energy error {de:.3e}");
-        within(&format!("angular momentum drifts by {dh:.3e}"), dh, 1e-10);
-        // Bounded, O(h^2): measured 1.2e-4 at dt = 0.02 (omega h ~ 0.025).
-        within(&format!("energy error {de:.3e}"), de, 1e-3);
+        within(&format!("angular momentum drifts by {dh:.3e}"), dh, 5e-11); // measured 1.3e-11
+                                                                            // Bounded, O(h^2): measured 1.2e-4 at dt = 0.02 (omega h ~ 0.025).
+        within(&format!("energy error {de:.3e}"), de, 6e-5); // measured 1.7e-5
         errs.push(e);
     }
     for w in errs.windows(2) {
@@ -218,8 +218,21 @@ fn fet_follows_the_two_bar_reduced_equations() {
     };
     let errs: Vec<f64> = [0.05, 0.025, 0.0125].map(error).to_vec();
     eprintln!("two-bar FET, t <= 10 s: max centre-of-mass errors {errs:?} m");
-    // HHT -0.1 at dt = 0.05: 2.7e-2 m (rigid.rs).
-    within(&format!("{errs:?}"), errs[0], 3.5e-2);
+    within("FET centre-of-mass error at dt 0.05 s [m]", errs[0], 3e-2); // measured 9.8e-3
+                                                                        // The README's claim: 2.8 times more accurate than HHT -0.1 at the paper's step.
+    let hht = {
+        let tr = two_bar(0.05, 10.0, Request::default()).unwrap_or_else(|(_, m)| panic!("{m}"));
+        let t = tr.col("t");
+        let refs = reference.case1(PI / 2.0, &t);
+        (0..t.len())
+            .map(|k| com_error(&tr, k, &refs[k]))
+            .fold(0.0, f64::max)
+    };
+    eprintln!(
+        "two-bar HHT -0.1 at dt 0.05 s: {hht:.3e} m, {:.2} times FET's",
+        hht / errs[0]
+    );
+    above("HHT error / FET error at dt 0.05 s", hht / errs[0], 2.5); // measured 2.77
     for w in errs.windows(2) {
         let p = order(w[0], w[1]);
         assert!((1.8..=2.3).contains(&p), "order {p:.3} (errors {errs:?})");
@@ -248,7 +261,7 @@ fn fet_keeps_the_oscillation_a_kinked_drive_excites_and_hht_damps_it() {
     let (f_kink, f_late) = (sawtooth(&f, 206..240), sawtooth(&f, 360..398));
     let (h_kink, h_late) = (sawtooth(&h, 206..240), sawtooth(&h, 360..398));
     eprintln!("drive-torque sawtooth after the kink / at the end: FET {f_kink:.3e} / {f_late:.3e} N m, HHT -0.1 {h_kink:.3e} / {h_late:.3e} N m");
-    above(&format!("the kink must excite FET: {f_kink}"), f_kink, 1e-3);
+    above(&format!("the kink must excite FET: {f_kink}"), f_kink, 5e-3); // measured 1.4e-2
     above(
         &format!("FET has no dissipation: {f_kink} -> {f_late}"),
         f_late,
@@ -257,8 +270,8 @@ fn fet_keeps_the_oscillation_a_kinked_drive_excites_and_hht_damps_it() {
     within(
         &format!("HHT -0.1 damps it: {h_kink} -> {h_late}"),
         h_late,
-        1e-4 * h_kink,
-    );
+        8e-6 * h_kink,
+    ); // measured 2.4e-6 * h_kink
 }
 
 /// THEORY §8.2: the midpoint rule is not stable for stiff beams in large motion (Simo & Tarnow
@@ -274,6 +287,8 @@ fn fet_on_stiff_beams_in_large_motion_fails_with_a_hint() {
     let t = tr.col("t");
     let reached = t.last().copied().unwrap_or(0.0);
     eprintln!("two_bar_beams under FET fails at {reached} s: {message}");
-    above(&format!("fails early, at {reached} s"), reached, 2.0);
+    // Measured: 6.1 s (step 123 of 1,000), the README's figure.
+    above(&format!("fails at {reached} s"), reached, 5.5);
+    within(&format!("fails at {reached} s"), reached, 6.7);
     assert!(message.contains("time element"), "{message}");
 }

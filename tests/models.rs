@@ -268,8 +268,8 @@ fn windmill_builds_n_blades_spinning_about_the_hub() {
                 within(
                     "(mast.section.stiffness[4][4] - k_t * h.powi(3) / 12.0).abs()",
                     (mast.section.stiffness[4][4] - k_t * h.powi(3) / 12.0).abs(),
-                    1e-9 * k_t,
-                );
+                    3e-15 * k_t,
+                ); // measured 8.5e-16 * k_t
                 assert!(
                     close(mast.nodes[mast.nodes.len() - 1], [0.0, 0.0, 0.0], 1e-12),
                     "the mast's top carries the hub"

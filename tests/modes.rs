@@ -115,8 +115,8 @@ fn hinged_rods_and_rigid_blades_match_the_closed_forms_at_every_speed() {
                         within(
                             &format!("e {e}, k {k}, Omega {omega}: {wi} vs {exact} rad/s"),
                             err,
-                            1e-9,
-                        );
+                            1e-10,
+                        ); // measured 3.4e-11 (the README's 1e-10)
                     }
                 }
             }
@@ -135,8 +135,8 @@ fn the_issue_s_two_cases_give_the_textbook_frequencies() {
     within(
         &format!("{flap:?}"),
         (flap[0] - 20.233_017_570_300_9).abs(),
-        1e-9,
-    );
+        8e-14,
+    ); // measured 2.1e-14
     let lag = omegas("lag", &rotor(Body::Rod, Hinge::Lag, 2, 0.3, 100.0, 20.0));
     assert!(
         lag.iter().all(|w| (w - 9.968_701_018_7).abs() < 1e-8),
@@ -244,7 +244,7 @@ solve hht {{ dt = 1 ms, until = 1 s }}
     // the second flap mode.
     let w0 = omegas("still", &model(0.0));
     let (flap0, lag0) = (w0[0], w0[1]);
-    within(&format!("{w0:?}"), (lag0 / flap0 - 2.0).abs(), 1e-4);
+    within(&format!("{w0:?}"), (lag0 / flap0 - 2.0).abs(), 5e-5); // measured 1.4e-5
     let mut errors = Vec::new();
     for omega in [5.0, 10.0] {
         let w = omegas("spinning", &model(omega));
@@ -308,8 +308,8 @@ fn a_blade_coned_by_gravity_is_analysed_about_its_steady_coning_angle() {
     within(
         &format!("moved {} vs {tip}", m.moved),
         (m.moved - tip).abs(),
-        1e-12 * tip,
-    );
+        4e-15 * tip,
+    ); // measured 1.2e-15 * tip
 }
 
 /// A teetering rotor (two rods welded to a yoke on a teeter hinge) on a hub driven at Omega,
@@ -479,20 +479,20 @@ fn a_fan_plot_follows_the_flap_mode_against_the_rotor_speed() {
         within(
             "(num(0) - omega).abs()",
             (num(0) - omega).abs(),
-            1e-12 * omega.max(1.0),
-        );
+            6e-16 * omega.max(1.0),
+        ); // measured 1.7e-16 * omega.max(1.0)
         assert_eq!(r[1], "1");
         let exact = closed_form(Hinge::Flap, 0.3, 100.0, omega);
         within(
             &format!("{r:?} vs {exact}"),
             (num(3) - exact).abs(),
-            1e-9 * exact,
-        );
+            4e-11 * exact,
+        ); // measured 1.1e-11 * exact
         within(
             "(num(8) - omega).abs()",
             (num(8) - omega).abs(),
-            1e-9 * omega.max(1.0),
-        );
+            6e-16 * omega.max(1.0),
+        ); // measured 1.7e-16 * omega.max(1.0)
     }
     let chart = std::fs::read_to_string(&svg).expect("svg");
     assert!(

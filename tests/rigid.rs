@@ -267,13 +267,10 @@ fn numerical_dissipation_delays_and_removes_the_instability() {
     let (o0, o5, o10) = (onset(0.0), onset(-0.05), onset(-0.1));
     eprintln!("largest exact acceleration {amax:.3} m/s^2; onset: alpha 0 {o0:?} s, -0.05 {o5:?} s, -0.1 {o10:?} s (paper: 22.15 s, 40.65 s, none)");
     let o0 = o0.expect("alpha = 0 stays bounded, unlike the paper's");
-    within("o0", o0, 50.0);
-    if let Some(o5) = o5 {
-        assert!(
-            o5 > o0,
-            "alpha = -0.05 goes unstable at {o5} s, before alpha = 0 ({o0} s)"
-        );
-    }
+    let o5 = o5.expect("alpha = -0.05 stays bounded, unlike the paper's");
+    // Measured: 11.4 s and 13.1 s (the paper: 22.15 s and 40.65 s).
+    assert!(o5 < 50.0, "alpha -0.05 at {o5} s");
+    above("delay of the onset by alpha = -0.05 [s]", o5 - o0, 0.5); // measured 1.7 s
     assert!(o10.is_none(), "alpha = -0.1 grows at {o10:?} s");
 }
 
@@ -291,7 +288,11 @@ fn two_bar_case_two_starts_impulsively_and_follows_the_exact_solution() {
         let tr = simulate_text("two_bar_spin.mbd", &text, overrides(dt, 50.0))
             .unwrap_or_else(|(_, m)| panic!("{m}"));
         let start = tr.col("th2dot")[0];
-        within(&format!("th2dot(0+) = {start}"), (start - 0.75).abs(), 1e-9);
+        within(
+            &format!("th2dot(0+) = {start}"),
+            (start - 0.75).abs(),
+            4e-16,
+        ); // measured 1.1e-16
         let t = times(&tr);
         let refs = reference.case2(0.5, PI / 2.0, th2dot0, &t);
         let (th2, torque) = (tr.col("theta2"), tr.col("torque"));

@@ -178,8 +178,10 @@ fn mutated_models_never_panic_or_hang() {
             for k in 0..per_file {
                 let input = mutate(text, &mut rng);
                 *watched.lock().expect("lock") = format!("mutation {k} of {name}:\n{input}");
-                let result = std::panic::catch_unwind(|| compile_mutant(name, &input))
-                    .map_err(|_| format!("the compiler panicked on mutation {k} of {name}:\n{input}"));
+                let result =
+                    std::panic::catch_unwind(|| compile_mutant(name, &input)).map_err(|_| {
+                        format!("the compiler panicked on mutation {k} of {name}:\n{input}")
+                    });
                 if tx.send(result).is_err() {
                     return;
                 }
@@ -207,7 +209,10 @@ fn mutated_models_never_panic_or_hang() {
 }
 
 /// Runs the binary with a wall-clock limit; `None` if it had to be killed.
-fn run_limited(args: &[&std::ffi::OsStr], limit: std::time::Duration) -> Option<std::process::Output> {
+fn run_limited(
+    args: &[&std::ffi::OsStr],
+    limit: std::time::Duration,
+) -> Option<std::process::Output> {
     let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mbd"))
         .args(args)
         .env("NO_COLOR", "1")
@@ -282,5 +287,8 @@ fn mutated_models_exit_zero_or_one_and_run_or_fail_cleanly() {
     }
     let _ = std::fs::remove_dir_all(&dir);
     // Both paths must be exercised, or the test proves little.
-    assert!(checked == 16 * corpus.len() && ran >= 10, "checked {checked}, ran {ran}");
+    assert!(
+        checked == 16 * corpus.len() && ran >= 10,
+        "checked {checked}, ran {ran}"
+    );
 }

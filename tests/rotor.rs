@@ -75,21 +75,30 @@ fn windmill_errors(blades: usize, omega_bar: f64, dt: Option<f64>) -> Vec<(Strin
     errors
 }
 
-/// Every channel within 2 % of its peak over the whole 3 s (issue 7's requirement); returns the
-/// largest error.
-fn assert_windmill(blades: usize, omega_bar: f64) -> f64 {
+/// Every channel within `bound` of its peak over the whole 3 s at the shipped dt (issue 7 asked
+/// for 2 %), and converging: the largest error at dt = 1 ms over the largest at 0.5 ms gives an
+/// observed order above 1.7 (HHT is second order; dt must divide 5 ms, see below).
+fn assert_windmill(blades: usize, omega_bar: f64, bound: f64) {
     let errors = windmill_errors(blades, omega_bar, None);
     for (name, e) in &errors {
         within(
-            &format!(
-                "{blades} blades, Omega_bar {omega_bar}: {name} off by {:.3} % of its peak",
-                100.0 * e
-            ),
+            &format!("{blades} blades, Omega_bar {omega_bar}: {name} / its peak"),
             *e,
-            0.02,
+            bound,
         );
     }
-    errors.iter().map(|(_, e)| *e).fold(0.0, f64::max)
+    let fine = errors.iter().map(|(_, e)| *e).fold(0.0, f64::max);
+    let coarse = windmill_errors(blades, omega_bar, Some(1e-3))
+        .iter()
+        .map(|(_, e)| *e)
+        .fold(0.0, f64::max);
+    let p = (coarse / fine).log2();
+    eprintln!("windmill, {blades} blades, Omega_bar {omega_bar}: observed order {p:.2} between dt 1 ms and 0.5 ms");
+    above(
+        &format!("{blades} blades, Omega_bar {omega_bar}: order ({coarse:.3e}, {fine:.3e})"),
+        p,
+        1.7,
+    );
 }
 
 /// The reference is converged far below anything checked here: tightening its tolerance a
@@ -107,19 +116,19 @@ fn windmill_reference_is_converged() {
         let b: Vec<f64> = fine.iter().map(|y| y[c]).collect();
         let e = rel_error(&a, &b);
         eprintln!("windmill reference, channel {c}: rtol 1e-9 against 1e-11 {e:.3e} of the peak");
-        within(&format!("channel {c}: {e:.3e}"), e, 1e-8);
+        within(&format!("channel {c}: {e:.3e}"), e, 3e-13); // measured 7.3e-14
     }
 }
 
 /// P5 as shipped, four blades, stable (Omega_bar = 1: all roots neutral). Measured: every
-/// channel within 0.006 % of its peak.
+/// channel within 5.8e-5 of its peak.
 #[test]
 fn windmill_stable_rotor_follows_the_nonlinear_equations() {
-    assert_windmill(4, 1.0);
+    assert_windmill(4, 1.0, 1.5e-4);
 }
 
 /// P5 as shipped, four blades, unstable (Omega_bar = 2: the regressing lag mode grows as
-/// exp(1.281 t), about 47-fold over the run). Measured: within 0.010 % of the peak. At dt = 1 ms
+/// exp(1.281 t), about 47-fold over the run). Measured: within 1.04e-4 of the peak. At dt = 1 ms
 /// the error is 0.090 %: it converges at least at second order (measured 3.1; 3.2 and 3.3 on to
 /// 0.25 and 0.125 ms: HHT's low-frequency dissipation is third order in dt, and its second-order
 /// phase error is small at omega dt < 0.01), so the agreement is convergence to the reference
@@ -127,22 +136,16 @@ fn windmill_stable_rotor_follows_the_nonlinear_equations() {
 /// off its peak, its impulse is 4 % short, and so is every channel.)
 #[test]
 fn windmill_unstable_rotor_follows_the_nonlinear_equations() {
-    let fine = assert_windmill(4, 2.0);
-    let coarse = windmill_errors(4, 2.0, Some(1e-3))
-        .iter()
-        .map(|(_, e)| *e)
-        .fold(0.0, f64::max);
-    let p = (coarse / fine).log2();
-    eprintln!("windmill, Omega_bar 2: observed order {p:.2} between dt 1 ms and 0.5 ms");
-    above(&format!("order {p:.2} ({coarse:.3e}, {fine:.3e})"), p, 1.7);
+    assert_windmill(4, 2.0, 3e-4); // measured 1.04e-4
 }
 
 /// Three and five blades at Omega_bar = 2, each against the equations with its own N (and
-/// M = ma + N mb, kT = M omega_T^2, as the model builds them). Measured: within 0.012 %.
+/// M = ma + N mb, kT = M omega_T^2, as the model builds them). Measured: within 1.1e-4 (3) and
+/// 1.24e-4 (5) of the peak.
 #[test]
 fn windmill_with_three_and_five_blades_follows_the_nonlinear_equations() {
-    assert_windmill(3, 2.0);
-    assert_windmill(5, 2.0);
+    assert_windmill(3, 2.0, 3e-4);
+    assert_windmill(5, 2.0, 4e-4);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -344,8 +347,8 @@ fn check_momentum(s: &Spin, t0: f64) -> (f64, f64) {
     within(
         &format!("T0 {t0}: rotor speed {measured:.3} rad/s, impulse predicts {predicted:.3}"),
         (measured / predicted - 1.0).abs(),
-        0.01,
-    );
+        0.002,
+    ); // measured 5.1e-4
     (residual, correction)
 }
 

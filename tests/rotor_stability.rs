@@ -67,8 +67,8 @@ fn floquet_finds_the_ground_resonance_band_of_the_multiblade_equations() {
         within(
             &format!("edge {} vs {want}", e.value),
             (e.value - want).abs(),
-            0.02,
-        );
+            0.01,
+        ); // measured 3.0e-3
         within(
             &format!("{:?}", e.bracket),
             e.bracket.1 - e.bracket.0,
@@ -141,18 +141,20 @@ fn growth_rates_match_the_multiblade_eigenvalues_for_3_4_and_5_blades() {
                 im.abs(),
                 rel
             );
-            within(
-                &format!("N = {blades} at {}: {got} vs {want}", p.value),
-                rel,
-                0.02,
-            );
+            // The README's claim is 1e-4 relative; measured: Floquet 1.2e-5, Prony 6.3e-5.
+            let bound = match p.method {
+                Method::Floquet => 3.5e-5,
+                Method::Prony => 1e-4,
+            };
+            let what = format!("{} growth, N = {blades} at {}", p.method.name(), p.value);
+            within(&what, rel, bound);
             let top = p.modes[0];
             match p.method {
                 Method::Prony => within(
-                    "(top.im - im.abs()).abs()",
-                    (top.im - im.abs()).abs(),
-                    0.01 * im.abs(),
-                ),
+                    &format!("prony frequency, N = {blades} at {}", p.value),
+                    (top.im - im.abs()).abs() / im.abs(),
+                    1.2e-5,
+                ), // measured 4.3e-6 (relative)
                 Method::Floquet => {
                     // Known modulo Omega: the distance of the frequencies to a multiple of it.
                     let omega = p.value * OMEGA_T;
@@ -161,10 +163,10 @@ fn growth_rates_match_the_multiblade_eigenvalues_for_3_4_and_5_blades() {
                         .map(|x| (x / omega - (x / omega).round()).abs() * omega)
                         .fold(f64::INFINITY, f64::min);
                     within(
-                        &format!("frequency {} vs {im} mod {omega}", top.im),
-                        d,
-                        0.01 * im.abs(),
-                    );
+                        &format!("floquet frequency {} vs {im} mod {omega}", top.im),
+                        d / im.abs(),
+                        6e-6,
+                    ); // measured 1.7e-6 (relative)
                 }
             }
         }
@@ -183,9 +185,9 @@ fn prony_finds_the_neutral_modes_of_the_stable_rotor() {
             .iter()
             .find(|m| (m.im - want).abs() < 2e-3)
             .unwrap_or_else(|| panic!("no mode at {want} rad/s: {:?}", p.modes));
-        within(&format!("{m:?}"), m.re.abs(), 1e-4);
+        within(&format!("{m:?}"), m.re.abs(), 5e-7); // measured 1.6e-7
     }
-    within("p.max_real().abs()", p.max_real().abs(), 1e-4);
+    within("p.max_real().abs()", p.max_real().abs(), 5e-7); // measured 1.6e-7
 }
 
 #[test]

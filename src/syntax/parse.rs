@@ -58,7 +58,8 @@ fn check_nesting(text: &str, source: SourceId) -> Result<(), Diagnostic> {
 /// Parses a whole model file.
 pub fn parse_file(text: &str, source: SourceId) -> Result<File, Diagnostic> {
     check_nesting(text, source)?;
-    let mut pairs = MbdParser::parse(Rule::file, text).map_err(|e| syntax_error(e, source))?;
+    let mut pairs =
+        MbdParser::parse(Rule::file, text).map_err(|e| syntax_error(e, text, source))?;
     let file = pairs
         .next()
         .ok_or_else(|| Diagnostic::error(Code::E0101, "empty parse"))?;
@@ -71,7 +72,8 @@ pub fn parse_file(text: &str, source: SourceId) -> Result<File, Diagnostic> {
 /// Parses a standalone expression, such as the VALUE of `--set NAME=VALUE`.
 pub fn parse_expr(text: &str, source: SourceId) -> Result<Expr, Diagnostic> {
     check_nesting(text, source)?;
-    let mut pairs = MbdParser::parse(Rule::expr_only, text).map_err(|e| syntax_error(e, source))?;
+    let mut pairs =
+        MbdParser::parse(Rule::expr_only, text).map_err(|e| syntax_error(e, text, source))?;
     let cx = Cx { source };
     let top = pairs.next().and_then(|p| p.into_inner().next());
     match top {
@@ -83,7 +85,8 @@ pub fn parse_expr(text: &str, source: SourceId) -> Result<Expr, Diagnostic> {
 /// Parses a `--set` argument `NAME=VALUE` held as its own source text.
 pub fn parse_set_arg(text: &str, source: SourceId) -> Result<(Ident, Expr), Diagnostic> {
     check_nesting(text, source)?;
-    let mut pairs = MbdParser::parse(Rule::set_arg, text).map_err(|e| syntax_error(e, source))?;
+    let mut pairs =
+        MbdParser::parse(Rule::set_arg, text).map_err(|e| syntax_error(e, text, source))?;
     let cx = Cx { source };
     let mut it = pairs
         .next()
@@ -106,10 +109,24 @@ pub fn parse_rule(rule: Rule, text: &str) -> bool {
     }
 }
 
-fn syntax_error(e: pest::error::Error<Rule>, source: SourceId) -> Diagnostic {
+/// The end of the token that starts at `start`: a word (name or number), or one other
+/// character; `start` itself at whitespace or the end of the text, where there is nothing to
+/// point at.
+fn token_end(text: &str, start: usize) -> usize {
+    let rest = text.get(start..).unwrap_or("");
+    let word = |c: char| c.is_alphanumeric() || c == '_' || c == '.';
+    match rest.chars().next() {
+        None => start,
+        Some(c) if c.is_whitespace() => start,
+        Some(c) if word(c) => start + rest.find(|c: char| !word(c)).unwrap_or(rest.len()),
+        Some(c) => start + c.len_utf8(),
+    }
+}
+
+fn syntax_error(e: pest::error::Error<Rule>, text: &str, source: SourceId) -> Diagnostic {
     use pest::error::{ErrorVariant, InputLocation};
     let (start, end) = match e.location {
-        InputLocation::Pos(p) => (p, p),
+        InputLocation::Pos(p) => (p, token_end(text, p)),
         InputLocation::Span((a, b)) => (a, b),
     };
     let expected = match &e.variant {

@@ -137,16 +137,23 @@ fn build_model(
     let header = match &out.header {
         Some((_, _, span)) => *span,
         None => {
-            let at = Span {
-                end: file.span.start,
-                ..file.span
+            // The first line with text: the header belongs before it.
+            let text = sources.text(file.span.source);
+            let from = file.span.start as usize;
+            let rest = text.get(from..).unwrap_or("");
+            let start = from + (rest.len() - rest.trim_start().len());
+            let line = text[start..].lines().next().unwrap_or("").trim_end();
+            let at = Span::new(file.span.source, start, start + line.len());
+            let insert_at = Span {
+                end: at.start,
+                ..at
             };
             sink.push(
                 Diagnostic::error(Code::E0103, "the file has no `model` header")
-                    .at(at, "expected `model NAME \"title\"` here")
+                    .at(at, "expected `model NAME \"title\"` before this")
                     .hint("begin the file with `model NAME \"what it is\"`"),
             );
-            at
+            insert_at
         }
     };
     let mut b = Builder::new(env, sink);
