@@ -101,8 +101,16 @@ pub fn above(what: &str, measured: f64, floor: f64) {
 fn record(at: &std::panic::Location, what: &str, measured: f64, bound: f64) {
     use std::io::Write;
     if let Some(path) = std::env::var_os("MBD_BOUNDS") {
-        let line = format!("{}:{}\t{what}\t{measured:.3e}\t{bound:.3e}\n", at.file(), at.line());
-        if let Ok(mut f) = std::fs::OpenOptions::new().create(true).append(true).open(path) {
+        let line = format!(
+            "{}:{}\t{what}\t{measured:.3e}\t{bound:.3e}\n",
+            at.file(),
+            at.line()
+        );
+        if let Ok(mut f) = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+        {
             let _ = f.write_all(line.as_bytes());
         }
     }

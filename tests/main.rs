@@ -9,6 +9,7 @@ mod docs;
 mod fet;
 mod friction;
 mod grammar;
+mod joints;
 mod loads;
 mod mbc;
 mod models;
