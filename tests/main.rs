@@ -6,6 +6,7 @@ mod cli;
 mod common;
 mod diagnostics;
 mod docs;
+mod emit;
 mod fet;
 mod friction;
 mod grammar;

@@ -73,24 +73,24 @@ fn screw_errors(
     let t = tr.col("t");
     let r0 = rot_x(TILT);
     let mut worst = [0.0f64; 4];
-    for k in 0..t.len() {
-        let rz = rot_z(SPIN * t[k]);
+    for (k, &tk) in t.iter().enumerate() {
+        let rz = rot_z(SPIN * tk);
         let r = mul(&rz, &r0);
         let rc = apply(&rz, [E, 0.0, 0.0]);
         // J_c z = R diag(I) R^T z.
         let jz = apply(&r, std::array::from_fn(|i| I[i] * r[2][i]));
         let gyro = cross([0.0, 0.0, SPIN * SPIN], jz);
-        let lever = cross(rc, [0.0, 0.0, 1.0]).map(|x| MASS * (zdd(t[k]) - g_z) * x);
+        let lever = cross(rc, [0.0, 0.0, 1.0]).map(|x| MASS * (zdd(tk) - g_z) * x);
         let moment = std::array::from_fn(|i| gyro[i] + lever[i]);
         let force = rc.map(|x| -MASS * SPIN * SPIN * x);
         let errors = [
-            dist(vector(tr, "p", k), [0.0, 0.0, z(t[k])]),
+            dist(vector(tr, "p", k), [0.0, 0.0, z(tk)]),
             rotation_angle(&rotation(tr, "wheel", k), &r),
             dist(vector(tr, "f", k), force),
             dist(vector(tr, "mo", k), moment),
         ];
-        for i in 0..4 {
-            worst[i] = worst[i].max(errors[i]);
+        for (w, e) in worst.iter_mut().zip(errors) {
+            *w = w.max(e);
         }
     }
     worst
