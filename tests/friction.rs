@@ -443,12 +443,12 @@ solve hht { dt = 1 ms, until = 0.01 s }
         // omega x r with r = 1 m at 120 deg steps: 2 m/s along the tangent.
         let a = (k as f64 * 120.0).to_radians();
         within(
-            &format!("{v}"),
+            v,
             (at0(&format!("{v}.x")) + 2.0 * a.sin()).abs(),
             8e-16,
         ); // measured 2.2e-16
         within(
-            &format!("{v}"),
+            v,
             (at0(&format!("{v}.y")) - 2.0 * a.cos()).abs(),
             1e-9,
         );
