@@ -442,16 +442,8 @@ solve hht { dt = 1 ms, until = 0.01 s }
     for (k, v) in ["v0", "v1", "v2"].iter().enumerate() {
         // omega x r with r = 1 m at 120 deg steps: 2 m/s along the tangent.
         let a = (k as f64 * 120.0).to_radians();
-        within(
-            v,
-            (at0(&format!("{v}.x")) + 2.0 * a.sin()).abs(),
-            8e-16,
-        ); // measured 2.2e-16
-        within(
-            v,
-            (at0(&format!("{v}.y")) - 2.0 * a.cos()).abs(),
-            1e-9,
-        );
+        within(v, (at0(&format!("{v}.x")) + 2.0 * a.sin()).abs(), 8e-16); // measured 2.2e-16
+        within(v, (at0(&format!("{v}.y")) - 2.0 * a.cos()).abs(), 1e-9);
     }
     within(
         "(at0('w2.z') - 2.0).abs()",
