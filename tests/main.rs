@@ -1,6 +1,7 @@
 //! One integration-test binary (keeps link time down); each module is one concern.
 
 mod architecture;
+mod beam_order;
 mod beams;
 mod cli;
 mod common;
@@ -22,4 +23,8 @@ mod rigid;
 mod robustness;
 mod rotor;
 mod rotor_stability;
+mod shapes;
+mod spectral;
 mod study;
+mod timoshenko;
+mod towers;
