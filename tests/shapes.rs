@@ -7,6 +7,7 @@
 
 use crate::cli::{code, mbd, stderr, temp};
 use crate::common::within;
+use crate::study::cells;
 use crate::timoshenko::{self, CANTILEVER_EB};
 use std::collections::HashMap;
 use std::f64::consts::PI;
@@ -35,17 +36,6 @@ fn phi(n: usize, x: f64) -> (f64, f64) {
         y.cosh() - y.cos() - s * (y.sinh() - y.sin()),
         b * (y.sinh() + y.sin() - s * (y.cosh() - y.cos())),
     )
-}
-
-/// A CSV file's header and rows of fields.
-fn table(path: &std::path::Path) -> (String, Vec<Vec<String>>) {
-    let text = std::fs::read_to_string(path).expect("csv");
-    let mut lines = text.lines();
-    let header = lines.next().unwrap_or_default().to_string();
-    let rows = lines
-        .map(|l| l.split(',').map(str::to_string).collect())
-        .collect();
-    (header, rows)
 }
 
 fn num(s: &str) -> f64 {
@@ -170,7 +160,7 @@ fn modes_command_writes_the_euler_bernoulli_frequencies_and_shapes_of_a_cantilev
         "5",
     ]);
     assert_eq!(code(&o), 0, "{}", stderr(&o));
-    let (header, rows) = table(&modes_csv);
+    let (header, rows) = cells(&modes_csv);
     assert_eq!(
         header,
         "mode,frequency_hz,omega_rad_s,damping_ratio,real_per_s,imag_rad_s,frame"
@@ -205,7 +195,7 @@ fn modes_command_writes_the_euler_bernoulli_frequencies_and_shapes_of_a_cantilev
         3e-11,
     ); // measured 1.4e-11
 
-    let (header, rows) = table(&shapes_csv);
+    let (header, rows) = cells(&shapes_csv);
     assert_eq!(header, "mode,unknown,entity,kind,real,imag,frame");
     let what = unknowns(model);
     // Every node's 6 unknowns for each of the 5 modes (the clamp's multipliers are left out).
@@ -271,8 +261,8 @@ fn modes_of_a_spinning_beam_are_written_in_the_rotating_frame() {
         "{}",
         stderr(&o)
     );
-    let (_, modes) = table(&modes_csv);
-    let (_, shapes) = table(&shapes_csv);
+    let (_, modes) = cells(&modes_csv);
+    let (_, shapes) = cells(&shapes_csv);
     assert_eq!(modes.len(), 3);
     assert!(!shapes.is_empty());
     assert!(modes.iter().chain(&shapes).all(|r| r[6] == "rotating"));

@@ -14,7 +14,7 @@ fn path(p: &std::path::Path) -> &str {
 }
 
 /// The study CSV as header and rows of cells (empty cells stay empty).
-fn cells(p: &std::path::Path) -> (String, Vec<Vec<String>>) {
+pub fn cells(p: &std::path::Path) -> (String, Vec<Vec<String>>) {
     let text = std::fs::read_to_string(p).unwrap_or_default();
     let mut lines = text.lines();
     let header = lines.next().unwrap_or_default().to_string();
