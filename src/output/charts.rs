@@ -5,6 +5,8 @@
 //! legend; non-finite points are skipped (a run that failed keeps the rows written so far, and
 //! the chart shows them); on log axes non-positive values are skipped.
 
+use super::ticks::{self, Ticks};
+use plotters::coord::ranged1d::{AsRangedCoord, DefaultFormatting, KeyPointHint, Ranged};
 use plotters::prelude::*;
 
 /// One line of a chart.
@@ -73,6 +75,48 @@ fn kept(p: &(f64, f64), log_x: bool, log_y: bool) -> bool {
     p.0.is_finite() && p.1.is_finite() && (!log_x || p.0 > 0.0) && (!log_y || p.1 > 0.0)
 }
 
+/// An axis (linear or log) with the ticks of `ticks.rs`: its labelled positions as the bold
+/// key points, its minor ones as the light key points. (plotters' own `WithKeyPoints` loses the
+/// value formatter of `f64` axes, which `configure_mesh` needs.)
+struct Keyed<R: Ranged<ValueType = f64>> {
+    inner: R,
+    major: Vec<f64>,
+    minor: Vec<f64>,
+}
+
+fn keyed<A: AsRangedCoord<Value = f64>>(range: A, ticks: &Ticks) -> Keyed<A::CoordDescType> {
+    Keyed {
+        inner: range.into(),
+        major: ticks.positions(),
+        minor: ticks.minor.clone(),
+    }
+}
+
+impl<R: Ranged<ValueType = f64>> Ranged for Keyed<R> {
+    type ValueType = f64;
+    type FormatOption = DefaultFormatting;
+
+    fn range(&self) -> std::ops::Range<f64> {
+        self.inner.range()
+    }
+
+    fn map(&self, value: &f64, limit: (i32, i32)) -> i32 {
+        self.inner.map(value, limit)
+    }
+
+    fn key_points<Hint: KeyPointHint>(&self, hint: Hint) -> Vec<f64> {
+        if hint.weight().allow_light_points() {
+            self.minor.clone()
+        } else {
+            self.major.clone()
+        }
+    }
+
+    fn axis_pixel_range(&self, limit: (i32, i32)) -> std::ops::Range<i32> {
+        self.inner.axis_pixel_range(limit)
+    }
+}
+
 /// Renders a chart as an SVG document (800 x 500).
 pub fn render(chart: &Chart) -> Result<String, String> {
     render_stack(std::slice::from_ref(chart))
@@ -120,6 +164,15 @@ fn draw(
     };
     let (x0, x1) = range(pts().map(|p| p.0), lx).ok_or("nothing to plot: no finite points")?;
     let (y0, y1) = range(pts().map(|p| p.1), ly).ok_or("nothing to plot: no finite points")?;
+    let axis = |lo: f64, hi: f64, log: bool| -> Ticks {
+        if log {
+            ticks::log(lo, hi)
+        } else {
+            ticks::linear(lo, hi)
+        }
+    };
+    let (xt, yt) = (axis(x0, x1, lx), axis(y0, y1, ly));
+    let (x_label, y_label) = (|v: &f64| xt.label(*v), |v: &f64| yt.label(*v));
     {
         let e = |e: DrawingAreaErrorKind<std::io::Error>| e.to_string();
         let mut builder = ChartBuilder::on(root);
@@ -135,6 +188,8 @@ fn draw(
             ($xr:expr, $yr:expr) => {{
                 let mut c = builder.build_cartesian_2d($xr, $yr).map_err(e)?;
                 c.configure_mesh()
+                    .x_label_formatter(&x_label)
+                    .y_label_formatter(&y_label)
                     .x_desc(chart.x_label.as_str())
                     .y_desc(chart.y_label.as_str())
                     .draw()
@@ -193,10 +248,13 @@ fn draw(
             }};
         }
         match (lx, ly) {
-            (false, false) => draw!(x0..x1, y0..y1),
-            (true, false) => draw!((x0..x1).log_scale(), y0..y1),
-            (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
-            (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
+            (false, false) => draw!(keyed(x0..x1, &xt), keyed(y0..y1, &yt)),
+            (true, false) => draw!(keyed((x0..x1).log_scale(), &xt), keyed(y0..y1, &yt)),
+            (false, true) => draw!(keyed(x0..x1, &xt), keyed((y0..y1).log_scale(), &yt)),
+            (true, true) => draw!(
+                keyed((x0..x1).log_scale(), &xt),
+                keyed((y0..y1).log_scale(), &yt)
+            ),
         }
     }
     Ok(())
@@ -290,6 +348,44 @@ mod tests {
         let svg = svg.unwrap_or_default();
         assert!(svg.starts_with("<svg"));
         assert!(svg.contains("<polyline"));
+    }
+
+    /// The texts of an SVG document.
+    fn texts(svg: &str) -> Vec<String> {
+        svg.split("<text")
+            .skip(1)
+            .filter_map(|t| {
+                let body = t.split_once('>')?.1;
+                Some(body.split_once("</text>")?.0.trim().to_string())
+            })
+            .collect()
+    }
+
+    /// Issue 19: the P3 chart's x axis (0.006 .. 0.01) showed one tick or piled-up labels, and
+    /// log labels float artefacts; linear axes wrote `-0.0`.
+    #[test]
+    fn axes_are_labelled_with_the_ticks_and_no_float_artefacts() {
+        let svg = render(&chart(
+            vec![(0.006, 2e-7), (0.0085, 3e-5), (0.01, 4e-3)],
+            true,
+        ))
+        .unwrap_or_default();
+        let t = texts(&svg);
+        for label in [
+            "0.006", "0.007", "0.008", "0.009", "0.01", "1e-6", "1e-5", "0.0001", "0.001",
+        ] {
+            assert!(t.iter().any(|x| x == label), "{label} missing from {t:?}");
+        }
+        let svg = render(&chart(vec![(0.0, -0.31), (1.0, 0.72)], false)).unwrap_or_default();
+        let t = texts(&svg);
+        assert!(
+            t.iter().any(|x| x == "0") && t.iter().any(|x| x == "-0.2"),
+            "{t:?}"
+        );
+        for x in &t {
+            assert!(!x.starts_with("-0") || x.starts_with("-0."), "{x}");
+            assert!(!x.contains("0000") && !x.contains("9999"), "artefact {x}");
+        }
     }
 
     #[test]

@@ -5,6 +5,7 @@
 //! Rows are written as they come, so a failed run keeps every row computed before the failure.
 
 pub mod charts;
+pub mod ticks;
 
 use crate::runtime::{Augment, State, System};
 use std::io::{self, Write};
