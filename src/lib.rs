@@ -11,6 +11,7 @@
 // Diagnostics are returned by value on cold paths only.
 #![allow(clippy::result_large_err)]
 
+pub mod channels;
 pub mod diagnostics;
 pub mod lower;
 pub mod model;
@@ -22,6 +23,8 @@ pub mod source;
 pub mod stdlib;
 pub mod study;
 pub mod syntax;
+
+pub use channels::{channel_quantity, channel_unit, param_label};
 
 use diagnostics::{Code, Diagnostic, Sink};
 use lower::Provenance;
@@ -349,44 +352,6 @@ pub fn modes(c: &Compiled, frozen: bool) -> Result<solve::modes::Modes, Diagnost
         solve::modes::ModesFailure::Runtime(f) => c.failure_diagnostic(&f),
         solve::modes::ModesFailure::Unsteady(why) => c.unsteady_diagnostic(&why),
     })
-}
-
-/// The unit of an output column as axes label it: `m`, `N`, `rad` for angles, `rad/s` for
-/// rates of turn, or `None` for a column the model does not write.
-pub fn channel_unit(c: &Compiled, column: &str) -> Option<String> {
-    use model::{BodyQuantity, JointKind, JointQuantity, Probe};
-    let o = c.model.outputs.iter().find(|o| o.column == column)?;
-    let turning = |q: &BodyQuantity| match q {
-        BodyQuantity::Crv => Some("rad"),
-        BodyQuantity::Rotation => Some("1"),
-        BodyQuantity::AngularVelocity => Some("rad/s"),
-        BodyQuantity::AngularAcceleration => Some("rad/s^2"),
-        _ => None,
-    };
-    let angular = match &o.probe {
-        Probe::Body { quantity, .. }
-        | Probe::Point { quantity, .. }
-        | Probe::CenterOfMass { quantity, .. } => turning(quantity),
-        Probe::Multiblade { .. } => Some("rad"),
-        Probe::Joint {
-            joint, quantity, ..
-        } => {
-            let revolute = !matches!(
-                c.model.joints.get(*joint).map(|j| &j.kind),
-                Some(JointKind::Prismatic { .. })
-            );
-            match quantity {
-                JointQuantity::Angle if revolute => Some("rad"),
-                JointQuantity::Rate if revolute => Some("rad/s"),
-                _ => None,
-            }
-        }
-        _ => None,
-    };
-    if let Some(u) = angular {
-        return Some(u.to_string());
-    }
-    model::channel_dim(&c.model.joints, &o.probe).map(|d| d.unit())
 }
 
 /// A number with at most six significant digits, no trailing zeros: `31.4`, `0.001`.

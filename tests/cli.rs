@@ -294,6 +294,7 @@ fn plot_draws_the_named_channels_of_a_run() {
     assert_eq!(code(&o), 0, "{}", stderr(&o));
     let text = std::fs::read_to_string(&svg).unwrap_or_default();
     assert!(text.starts_with("<svg"), "not an SVG");
+    crate::charts::check(&text, Some("plot_pendulum"));
     // One line per channel in its own colour (and its legend mark), the time axis labelled.
     for colour in ["#1F77B4", "#FF7F0E"] {
         assert!(
@@ -365,9 +366,20 @@ fn plot_with_the_model_puts_each_unit_on_its_own_axis() {
     let grouped = run(true);
     // Two panels: the lengths and the angles, each axis with its unit.
     assert!(grouped.contains("x_hub, rotor_cm.x [m]"), "lengths");
-    assert!(grouped.contains("zeta1, zeta2 [rad]"), "angles");
+    assert!(grouped.contains("joint angle [rad]"), "angles");
+    crate::charts::check(&grouped, Some("plot_windmill"));
     assert_eq!(grouped.matches("t [s]").count(), 2);
     // Without the model the CSV has no units: one axis, in SI, as before.
     let plain = run(false);
-    assert!(plain.contains("value (SI)") && !plain.contains("[rad]"));
+    assert!(plain.contains("values (SI units)") && !plain.contains("[rad]"));
+    crate::charts::check(&plain, None);
+    // `-o NAME.png` writes the same chart as a PNG.
+    let png = temp("plot_windmill.png", "");
+    let mut a = args(true);
+    let at = a.iter().position(|x| x.ends_with(".svg")).unwrap_or(0);
+    a[at] = png.to_string_lossy().to_string();
+    let refs: Vec<&str> = a.iter().map(String::as_str).collect();
+    assert_eq!(code(&mbd(&refs)), 0);
+    let bytes = std::fs::read(&png).unwrap_or_default();
+    assert!(bytes.starts_with(b"\x89PNG"), "not a PNG");
 }

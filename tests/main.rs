@@ -3,6 +3,7 @@
 mod architecture;
 mod beam_order;
 mod beams;
+mod charts;
 mod cli;
 mod common;
 mod diagnostics;

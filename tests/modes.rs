@@ -495,6 +495,7 @@ fn a_fan_plot_follows_the_flap_mode_against_the_rotor_speed() {
         ); // measured 1.7e-16 * omega.max(1.0)
     }
     let chart = std::fs::read_to_string(&svg).expect("svg");
+    crate::charts::check(&chart, Some("fan"));
     assert!(
         chart.contains("1/rev") && chart.contains("mode 1"),
         "per-rev lines and the mode"

@@ -254,6 +254,7 @@ fn the_stability_command_writes_its_csv_and_chart() {
     assert!(stdout.contains("unstable: "), "{stdout}");
     let svg = std::fs::read_to_string(&chart).expect("svg");
     assert!(svg.starts_with("<svg") && svg.contains("unstable"), "chart");
+    crate::charts::check(&svg, Some("stability_map"));
 }
 
 #[test]

@@ -103,6 +103,8 @@ fn pendulum_convergence_study_is_second_order_for_every_integrator() {
     }
     let chart = std::fs::read_to_string(&svg).unwrap_or_default();
     assert!(chart.starts_with("<svg"), "not an SVG");
+    // CPU times vary: the layout is checked, not the pixels.
+    crate::charts::check(&chart, None);
     for colour in ["#1F77B4", "#FF7F0E", "#2CA02C"] {
         assert!(
             chart.contains(&format!(
@@ -254,6 +256,7 @@ fn two_bar_stability_study_finds_the_onset_without_dissipation_only() {
         "{text}"
     );
     let chart = std::fs::read_to_string(&svg).unwrap_or_default();
+    crate::charts::check(&chart, Some("study_two_bar_growth"));
     for label in ["alpha = 0", "alpha = -0.1", "|ayc2|"] {
         assert!(chart.contains(label), "missing `{label}`");
     }

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
 # Regenerates the accuracy-against-cost charts of docs/charts/ (issue 6): for each validation
 # problem, `mbd study` runs HHT at two alphas, generalized-alpha and time finite elements over a
-# range of steps, and writes the study's CSV, its SVG chart and its printed report (observed
-# orders, CPU time to reach relative errors 1e-3 and 1e-6).
+# range of steps, and writes the study's CSV, its SVG chart (and a PNG of it) and its printed
+# report (observed orders, CPU time to reach relative errors 1e-3 and 1e-6).
 # Usage: docs/charts/make.sh   (from anywhere; builds the release binary first)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-cargo build --release --quiet
+cargo build --release --quiet --bin mbd --example svg_to_png
 mbd=target/release/mbd
 out=docs/charts
 integrators=hht:-0.1,hht:-0.3,generalized-alpha,fet
@@ -28,3 +28,6 @@ study p2_pendulum models/pendulum.mbd --channel x --steps 50,100,200,400,800,160
 # dominate until small steps).
 study p3_two_bar_10s models/two_bar.mbd --channel zc2 --until 10 --steps 200,400,800,1600,3200,6400
 study p3_two_bar_50s models/two_bar.mbd --channel zc2 --steps 1000,2000,4000,8000,16000
+
+# PNG beside every SVG (the README shows them).
+target/release/examples/svg_to_png "$out"/p[123]_*.svg

@@ -7,7 +7,7 @@
 # Usage: docs/charts/make_rotor.sh   (from anywhere; builds the release binary first)
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-cargo build --release --quiet --bin mbd --example windmill_mbc
+cargo build --release --quiet --bin mbd --example windmill_mbc --example svg_to_png
 mbd=target/release/mbd
 out=docs/charts
 
@@ -18,20 +18,26 @@ target/release/examples/windmill_mbc 4 > "$out/p5_mbc.csv"
 
 for w in 1.0 2.0; do
     "$mbd" run models/windmill.mbd --set Omega_bar=$w --every 10 -o "$out/p5_windmill_$w.csv"
-    "$mbd" plot "$out/p5_windmill_$w.csv" --channel zeta1 --channel zeta2 --channel zeta3 \
-        --channel zeta4 --title "P5 lag angles [rad], Omega_bar = $w (Figs. 19-21)" \
+    units=(--model models/windmill.mbd --set Omega_bar=$w)
+    "$mbd" plot "$out/p5_windmill_$w.csv" "${units[@]}" --channel zeta1 --channel zeta2 \
+        --channel zeta3 --channel zeta4 --title "P5 lag angles, Omega_bar = $w (Figs. 19-21)" \
         -o "$out/p5_lag_$w.svg"
-    "$mbd" plot "$out/p5_windmill_$w.csv" --channel x_hub \
-        --title "P5 hub displacement [m], Omega_bar = $w" -o "$out/p5_hub_$w.svg"
-    "$mbd" plot "$out/p5_windmill_$w.csv" --channel rotor_cm.x --channel rotor_cm.y \
-        --title "P5 rotor centre of mass [m], Omega_bar = $w (Fig. 22)" -o "$out/p5_cm_$w.svg"
+    "$mbd" plot "$out/p5_windmill_$w.csv" "${units[@]}" --channel x_hub \
+        --title "P5 hub displacement, Omega_bar = $w" -o "$out/p5_hub_$w.svg"
+    "$mbd" plot "$out/p5_windmill_$w.csv" "${units[@]}" --channel rotor_cm.x \
+        --channel rotor_cm.y --title "P5 rotor centre of mass, Omega_bar = $w (Fig. 22)" \
+        -o "$out/p5_cm_$w.svg"
 done
 
 for t0 in 2500 500; do
     "$mbd" run models/windmill_spinup.mbd --set T0=$t0 --every 10 -o "$out/p6_spinup_$t0.csv"
-    "$mbd" plot "$out/p6_spinup_$t0.csv" --channel Omega_hub \
-        --title "P6 rotor speed [rad/s], T0 = $t0 N m (Fig. 24)" -o "$out/p6_speed_$t0.svg"
-    "$mbd" plot "$out/p6_spinup_$t0.csv" --channel zeta1 --channel zeta3 --channel zeta_1c \
-        --channel zeta_1s --title "P6 lag angles [rad], T0 = $t0 N m (Fig. 24)" \
+    units=(--model models/windmill_spinup.mbd --set T0=$t0)
+    "$mbd" plot "$out/p6_spinup_$t0.csv" "${units[@]}" --channel Omega_hub \
+        --title "P6 rotor speed, T0 = $t0 N m (Fig. 24)" -o "$out/p6_speed_$t0.svg"
+    "$mbd" plot "$out/p6_spinup_$t0.csv" "${units[@]}" --channel zeta1 --channel zeta3 \
+        --channel zeta_1c --channel zeta_1s --title "P6 lag angles, T0 = $t0 N m (Fig. 24)" \
         -o "$out/p6_lag_$t0.svg"
 done
+
+# PNG beside every SVG (the README shows them).
+target/release/examples/svg_to_png "$out"/p[56]_*.svg

@@ -184,11 +184,12 @@ pub fn create_outputs<'a>(
     Ok((csv_file, chart_file))
 }
 
-/// Renders a chart into its file; a failure is reported, not fatal (the CSV is written).
+/// Renders a chart into its file (PNG for a `.png` name, else SVG); a failure is reported, not
+/// fatal (the CSV is written).
 pub fn draw(path: &str, file: &mut std::fs::File, chart: &mbd::output::charts::Chart) {
-    match mbd::output::charts::render(chart) {
-        Ok(svg) => {
-            if let Err(e) = file.write_all(svg.as_bytes()) {
+    match mbd::output::charts::encode(std::slice::from_ref(chart), path) {
+        Ok(bytes) => {
+            if let Err(e) = file.write_all(&bytes) {
                 eprintln!("error: cannot write chart file `{path}`: {e}");
             }
         }

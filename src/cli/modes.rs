@@ -63,7 +63,7 @@ pub struct ModesArgs {
     /// Modes against a param: NAME=START:STOP:STEP (STOP included; units allowed).
     #[arg(long, value_name = "NAME=START:STOP:STEP", allow_hyphen_values = true)]
     sweep: Option<String>,
-    /// With --sweep: write the fan plot here (SVG).
+    /// With --sweep: write the fan plot here (PNG for a `.png` name, else SVG).
     #[arg(long, value_name = "FAN.svg", requires = "sweep")]
     chart: Option<String>,
     /// Override a param: NAME=VALUE, VALUE in SI units or with units.
@@ -198,7 +198,9 @@ fn sweep(a: &ModesArgs, text: &str, spec: &str) -> ExitCode {
     }
     if let Some((p, f)) = chart.as_mut() {
         let title = format!("{}: natural frequencies against {param}", c.model.name);
-        draw(p, f, &result.chart(&title));
+        let mut chart = result.chart(&title);
+        chart.x_label = mbd::param_label(&c, &param);
+        draw(p, f, &chart);
     }
     let mut failed = false;
     for p in &result.points {

@@ -1,4 +1,4 @@
-//! `mbd plot`: time histories of channels of a run's CSV as an SVG chart, grouped by unit
+//! `mbd plot`: time histories of channels of a run's CSV as an SVG or PNG chart, grouped by unit
 //! with `--model`.
 
 use super::{compile, read, usage, Format};
@@ -12,7 +12,7 @@ pub struct PlotArgs {
     /// A channel to draw (repeat for several).
     #[arg(long = "channel", value_name = "NAME", required = true)]
     channels: Vec<String>,
-    /// Write the SVG here.
+    /// Write the chart here: PNG for a `.png` name, else SVG.
     #[arg(short = 'o', long = "output")]
     output: String,
     /// Chart title (default: the CSV's file name).
@@ -47,22 +47,32 @@ pub fn plot(a: PlotArgs) -> ExitCode {
         .file_name()
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_else(|| path.to_string());
-    let unit = |column: &str| compiled.as_ref().and_then(|c| mbd::channel_unit(c, column));
+    let describe = |column: &str| {
+        let c = compiled.as_ref()?;
+        Some((
+            mbd::channel_quantity(c, column)?,
+            mbd::channel_unit(c, column)?,
+        ))
+    };
+    let title = match &compiled {
+        Some(c) => format!("{}: time histories ({name})", c.model.name),
+        None => name,
+    };
     let charts = match mbd::output::charts::time_history(
-        a.title.as_deref().unwrap_or(&name),
+        a.title.as_deref().unwrap_or(&title),
         &header,
         &rows,
         &a.channels,
-        &unit,
+        &describe,
     ) {
         Ok(c) => c,
         Err(e) => return usage(&e),
     };
-    let svg = match mbd::output::charts::render_stack(&charts) {
+    let bytes = match mbd::output::charts::encode(&charts, output) {
         Ok(s) => s,
         Err(e) => return usage(&format!("cannot draw the chart: {e}")),
     };
-    match std::fs::write(output, svg) {
+    match std::fs::write(output, bytes) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => usage(&format!("cannot create output file `{output}`: {e}")),
     }

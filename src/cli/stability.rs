@@ -83,7 +83,7 @@ pub struct StabilityArgs {
     /// Write the sweep's CSV here.
     #[arg(short = 'o', long = "output", value_name = "STAB.csv")]
     output: String,
-    /// Write the chart here (SVG).
+    /// Write the chart here (PNG for a `.png` name, else SVG).
     #[arg(long, value_name = "STAB.svg")]
     chart: Option<String>,
 }
@@ -147,8 +147,10 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         return usage(&format!("cannot write `{}`: {e}", a.output));
     }
     if let Some((p, f)) = chart_file.as_mut() {
-        let title = format!("{}: stability against {}", c.model.name, spec.param);
-        draw(p, f, &result.chart(&title, reference));
+        let title = format!("{}: growth rates Re s against {}", c.model.name, spec.param);
+        let mut chart = result.chart(&title, reference);
+        chart.x_label = mbd::param_label(&c, &spec.param);
+        draw(p, f, &chart);
     }
     print_report(&result);
     exit_unless_failed(result.points.iter().any(|p| p.failure.is_some()))

@@ -28,7 +28,9 @@ is the reference channel's largest magnitude over the run (1 if it is zero throu
 at a time are the row at that time (within 1e-9 dt), else cubic (4-point Lagrange) \
 interpolation. The CSV has the columns integrator,dt,steps,error,cpu_s,newton_iters (cpu_s: \
 thread CPU time of the run alone); a failed run keeps its row with empty cells. The chart \
-plots error against CPU time on log-log axes, one line per integrator. Printed: the table, and \
+plots error against CPU time on log-log axes, one line per integrator with its observed order \
+in the legend, a dashed guide of order 2 (and 4 when an integrator exceeds 3), dotted lines at \
+the target errors 1e-3 and 1e-6; SVG, or PNG for a .png name. Printed: the table, and \
 each integrator's observed order (least-squares slope of log(error) against log(dt), and the \
 slope between its two finest runs).
 
@@ -83,7 +85,7 @@ pub struct StudyArgs {
     /// Write the study's CSV here.
     #[arg(short = 'o', long = "output", value_name = "STUDY.csv")]
     output: String,
-    /// Write the chart here (SVG).
+    /// Write the chart here (PNG for a `.png` name, else SVG).
     #[arg(long, value_name = "STUDY.svg")]
     chart: Option<String>,
 }
@@ -144,7 +146,7 @@ pub fn study(a: StudyArgs) -> ExitCode {
         base,
         counts,
         until,
-        title: format!("{}: {}", c.model.name, a.channel),
+        title: c.model.name.clone(),
         csv,
         chart,
     };
@@ -396,10 +398,11 @@ fn print_convergence(study: &convergence::Convergence, spec: &ConvergenceSpec) {
             Some((c, true)) => format!("{} s (extrapolated)", short(c)),
             None => "-".to_string(),
         };
+        let [coarse, fine] = mbd::study::convergence::TARGETS;
         say(&format!(
-            "{name}  CPU to reach 1e-3: {}; 1e-6: {}",
-            reach(1e-3),
-            reach(1e-6)
+            "{name}  CPU to reach {coarse:e}: {}; {fine:e}: {}",
+            reach(coarse),
+            reach(fine)
         ));
     }
 }

@@ -5,6 +5,9 @@
 //! Rows are written as they come, so a failed run keeps every row computed before the failure.
 
 pub mod charts;
+mod guides;
+mod legend;
+pub mod raster;
 pub mod ticks;
 
 use crate::runtime::{Augment, State, System};

@@ -3,7 +3,7 @@
 
 use super::compare::{observed_order, relative_error, Order, Reference, Samples};
 use super::{cell, Compile, IntegratorItem};
-use crate::output::charts::{Chart, Series};
+use crate::output::charts::{Chart, Guide, GuideLine, Series};
 use crate::runtime::timefn::TimeFn;
 use crate::settings::Request;
 use std::io::{self, Write};
@@ -202,14 +202,22 @@ impl Convergence {
         Ok(())
     }
 
-    /// Error against CPU time on log-log axes, one line per integrator (runs by step count).
-    pub fn chart(&self, title: &str, channel: &str) -> Chart {
+    /// Error against CPU time on log-log axes, one line per integrator (runs by step count)
+    /// with its observed order in the legend; dashed guides of slope -2 (and -4 when an
+    /// integrator's observed order exceeds 3) below the most accurate run, since the CPU time
+    /// of a fixed-step run is proportional to its step count; dotted lines at the [`TARGETS`].
+    pub fn chart(&self, model: &str, channel: &str) -> Chart {
         let mut series: Vec<Series> = Vec::new();
-        for (name, _) in self.orders() {
-            let mut runs: Vec<&Row> = self.rows.iter().filter(|r| r.integrator == name).collect();
+        let orders = self.orders();
+        for (name, order) in &orders {
+            let mut runs: Vec<&Row> = self.rows.iter().filter(|r| r.integrator == *name).collect();
             runs.sort_by_key(|r| r.steps);
+            let label = match order {
+                Some(o) => format!("{name}: order {:.2}", o.fit),
+                None => name.clone(),
+            };
             series.push(Series {
-                label: name,
+                label,
                 points: runs
                     .iter()
                     .filter_map(|r| Some((r.cpu_s?, r.error?)))
@@ -217,17 +225,64 @@ impl Convergence {
                 markers_only: false,
             });
         }
+        // Each guide passes a factor 2 below the most accurate run of the integrator whose
+        // observed order is nearest to the guide's (of all runs if none is within 1).
+        let best = |of: &[&Series]| {
+            of.iter()
+                .flat_map(|s| s.points.iter().copied())
+                .filter(|&(c, e)| c > 0.0 && e > 0.0 && c.is_finite() && e.is_finite())
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+        };
+        let fits: Vec<Option<f64>> = orders
+            .iter()
+            .map(|(_, o)| o.as_ref().map(|o| o.fit))
+            .collect();
+        let fourth = fits.iter().flatten().any(|&f| f > 3.0);
+        let mut guides = Vec::new();
+        for p in [2.0, 4.0].into_iter().filter(|&p| p < 3.0 || fourth) {
+            let nearest = series
+                .iter()
+                .zip(&fits)
+                .filter_map(|(s, f)| Some((s, (f.as_ref()? - p).abs())))
+                .filter(|(_, d)| *d < 1.0)
+                .min_by(|a, b| a.1.total_cmp(&b.1))
+                .map(|(s, _)| s);
+            let anchor = match nearest {
+                Some(s) => best(&[s]),
+                None => best(&series.iter().collect::<Vec<_>>()),
+            };
+            if let Some((c, e)) = anchor {
+                guides.push(Guide {
+                    label: format!("order {p}: error ~ CPU^-{p}"),
+                    line: GuideLine::Slope {
+                        through: (c, e / 2.0),
+                        slope: -p,
+                    },
+                });
+            }
+        }
+        for t in TARGETS {
+            guides.push(Guide {
+                label: "target errors".to_string(),
+                line: GuideLine::Level(t),
+            });
+        }
         Chart {
-            title: title.to_string(),
+            title: format!("{model}: relative error of {channel} against CPU time"),
             x_label: "CPU time per run [s]".to_string(),
             y_label: format!("relative error of {channel}"),
             log_x: true,
             log_y: true,
             series,
             shaded: Vec::new(),
+            guides,
         }
     }
 }
+
+/// The relative errors whose CPU cost the study reports (`mbd study` prints it; the chart
+/// draws them).
+pub const TARGETS: [f64; 2] = [1e-3, 1e-6];
 
 #[cfg(test)]
 mod tests {

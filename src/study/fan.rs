@@ -231,6 +231,7 @@ impl Fan {
             log_y: false,
             series,
             shaded: Vec::new(),
+            guides: Vec::new(),
         }
     }
 }

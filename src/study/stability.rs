@@ -209,10 +209,10 @@ pub fn write_csv(rows: &[StabilityRow], out: &mut dyn Write) -> io::Result<()> {
 }
 
 /// |channel| against time on a log axis, one line per run.
-pub fn chart(rows: &[StabilityRow], title: &str, channel: &str) -> Chart {
+pub fn chart(rows: &[StabilityRow], model: &str, channel: &str) -> Chart {
     let several_steps = rows.iter().any(|r| r.steps != rows[0].steps);
     Chart {
-        title: title.to_string(),
+        title: format!("{model}: growth of |{channel}| for each alpha"),
         x_label: "t [s]".to_string(),
         y_label: format!("|{channel}|"),
         log_x: false,
@@ -236,6 +236,7 @@ pub fn chart(rows: &[StabilityRow], title: &str, channel: &str) -> Chart {
             })
             .collect(),
         shaded: Vec::new(),
+        guides: Vec::new(),
     }
 }
 

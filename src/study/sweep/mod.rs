@@ -398,6 +398,7 @@ impl Sweep {
             log_y: false,
             series,
             shaded: self.unstable_ranges(),
+            guides: Vec::new(),
         }
     }
 }
