@@ -3,6 +3,7 @@
 //! Invariant: the symbolic factorization and the workspace are computed once per pattern;
 //! each Newton iteration refactors numerically into the same storage.
 
+use super::pivot_free::{PivotFree, TinyPivot};
 use crate::runtime::Pattern;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::lu::partial_pivoting::factor::PartialPivLuParams;
@@ -17,19 +18,37 @@ use faer::{Conj, MatMut, Par, Spec};
 pub enum LinearError {
     /// The matrix could not be factored (structurally or numerically singular).
     Singular,
+    /// The pivot-free factorization met a tiny pivot at this unknown, and the pivoting one
+    /// could not factor the matrix either.
+    TinyPivot(usize),
     /// The solution has non-finite entries (numerically singular matrix).
     NonFinite,
     /// faer reported an allocation failure.
     OutOfMemory,
 }
 
-pub struct SparseLu {
+/// faer's LU with partial pivoting, its symbolic factorization and workspace made once.
+struct Pivoting {
     n: usize,
     col_ptr: Vec<usize>,
     row_idx: Vec<usize>,
     symbolic: SymbolicLu<usize>,
     numeric: NumericLu<usize, f64>,
     mem: MemBuffer,
+}
+
+/// A sparse LU whose symbolic work is done once per pattern.
+///
+/// The iteration matrix's (`SparseLu::pivot_free`) factors without pivoting in the order of
+/// `ordering.rs`; should a pivot be tiny (a model the ordering does not cover), the matrix is
+/// factored with faer's partial pivoting from then on, and only if that fails too is it
+/// singular, at the unknown of the tiny pivot. Other matrices (the constrained mass matrix,
+/// which may hold massless rotations) use faer's from the start.
+pub struct SparseLu {
+    pattern: Pattern,
+    fast: Option<PivotFree>,
+    pivoting: Option<Pivoting>,
+    tiny: Option<usize>,
     factored: bool,
 }
 
@@ -51,8 +70,8 @@ fn symbolic_params(pattern: &Pattern) -> LuSymbolicParams<'static> {
     params
 }
 
-impl SparseLu {
-    pub fn new(pattern: &Pattern) -> Result<SparseLu, LinearError> {
+impl Pivoting {
+    fn new(pattern: &Pattern) -> Result<Pivoting, LinearError> {
         let n = pattern.n;
         let sym =
             SymbolicSparseColMatRef::new_checked(n, n, &pattern.col_ptr, None, &pattern.row_idx);
@@ -66,20 +85,17 @@ impl SparseLu {
             symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
         ]);
         let mem = MemBuffer::try_new(req).map_err(|_| LinearError::OutOfMemory)?;
-        Ok(SparseLu {
+        Ok(Pivoting {
             n,
             col_ptr: pattern.col_ptr.clone(),
             row_idx: pattern.row_idx.clone(),
             symbolic,
             numeric: NumericLu::new(),
             mem,
-            factored: false,
         })
     }
 
-    /// Numeric factorization of the matrix with this pattern and `values`.
-    pub fn factor(&mut self, values: &[f64]) -> Result<(), LinearError> {
-        self.factored = false;
+    fn factor(&mut self, values: &[f64]) -> Result<(), LinearError> {
         let sym = SymbolicSparseColMatRef::new_checked(
             self.n,
             self.n,
@@ -98,6 +114,76 @@ impl SparseLu {
                 Spec::<PartialPivLuParams, f64>::default(),
             )
             .map_err(|_| LinearError::Singular)?;
+        Ok(())
+    }
+
+    fn solve(&mut self, rhs: &mut [f64]) {
+        let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
+        let stack = MemStack::new(&mut self.mem);
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            MatMut::from_column_major_slice_mut(rhs, self.n, 1),
+            Par::Seq,
+            stack,
+        );
+    }
+}
+
+impl SparseLu {
+    /// faer's LU with partial pivoting.
+    pub fn new(pattern: &Pattern) -> Result<SparseLu, LinearError> {
+        Ok(SparseLu {
+            pattern: pattern.clone(),
+            fast: None,
+            pivoting: Some(Pivoting::new(pattern)?),
+            tiny: None,
+            factored: false,
+        })
+    }
+
+    /// The pivot-free LU of an iteration matrix whose multipliers are flagged in `late`.
+    pub fn pivot_free(pattern: &Pattern, late: &[bool]) -> SparseLu {
+        SparseLu {
+            pattern: pattern.clone(),
+            fast: Some(PivotFree::new(pattern, late)),
+            pivoting: None,
+            tiny: None,
+            factored: false,
+        }
+    }
+
+    /// The pivot-free factorization's size and work, for benchmarks.
+    pub fn describe(&self) -> Option<String> {
+        self.fast.as_ref().map(PivotFree::describe)
+    }
+
+    /// The unknown of the first tiny pivot met, after which faer's pivoting LU is used.
+    pub fn tiny_pivot(&self) -> Option<usize> {
+        self.tiny
+    }
+
+    /// Numeric factorization of the matrix with this pattern and `values`.
+    pub fn factor(&mut self, values: &[f64]) -> Result<(), LinearError> {
+        self.factored = false;
+        if self.tiny.is_none() {
+            if let Some(fast) = &mut self.fast {
+                match fast.factor(values) {
+                    Ok(()) => {
+                        self.factored = true;
+                        return Ok(());
+                    }
+                    Err(TinyPivot(i)) => self.tiny = Some(i),
+                }
+            }
+        }
+        if self.pivoting.is_none() {
+            self.pivoting = Some(Pivoting::new(&self.pattern)?);
+        }
+        let pivoting = self.pivoting.as_mut().expect("made above");
+        pivoting.factor(values).map_err(|e| match self.tiny {
+            Some(i) => LinearError::TinyPivot(i),
+            None => e,
+        })?;
         self.factored = true;
         Ok(())
     }
@@ -107,19 +193,15 @@ impl SparseLu {
         if !self.factored {
             return Err(LinearError::Singular);
         }
-        let lu = LuRef::new_unchecked(&self.symbolic, &self.numeric);
-        let stack = MemStack::new(&mut self.mem);
-        let n = self.n;
-        lu.solve_in_place_with_conj(
-            Conj::No,
-            MatMut::from_column_major_slice_mut(rhs, n, 1),
-            Par::Seq,
-            stack,
-        );
+        match (&mut self.fast, &mut self.pivoting) {
+            (Some(fast), _) if self.tiny.is_none() => fast.solve(rhs),
+            (_, Some(p)) => p.solve(rhs),
+            _ => return Err(LinearError::Singular),
+        }
         if rhs.iter().all(|x| x.is_finite()) {
             Ok(())
         } else {
-            Err(LinearError::NonFinite)
+            Err(self.tiny.map_or(LinearError::NonFinite, LinearError::TinyPivot))
         }
     }
 }
@@ -310,6 +392,31 @@ mod tests {
         let mut rhs = [12.0, 8.0, 2.0];
         lu.solve(&mut rhs).expect("solve");
         assert!(rhs.iter().all(|x| (x - 1.0).abs() < 1e-14));
+    }
+
+    #[test]
+    fn a_tiny_pivot_hands_the_matrix_to_the_pivoting_lu() {
+        // [[0, 1], [1, 0]] x = [2, 3]: no multiplier flagged, so the pivot-free order meets
+        // the zero first; faer's pivoting solves it, and keeps doing so.
+        let pattern = Pattern {
+            n: 2,
+            col_ptr: vec![0, 2, 4],
+            row_idx: vec![0, 1, 0, 1],
+        };
+        let mut lu = SparseLu::pivot_free(&pattern, &[false, false]);
+        for _ in 0..2 {
+            lu.factor(&[0.0, 1.0, 1.0, 0.0]).expect("pivoting factors it");
+            let mut x = [2.0, 3.0];
+            lu.solve(&mut x).expect("solve");
+            assert_eq!(x, [3.0, 2.0]);
+            assert_eq!(lu.tiny_pivot(), Some(0));
+        }
+        // A singular matrix names the unknown of the tiny pivot (faer factors it; the solution
+        // is not finite).
+        let factored = lu.factor(&[0.0, 0.0, 0.0, 0.0]);
+        let mut x = [2.0, 3.0];
+        let solved = factored.and_then(|()| lu.solve(&mut x));
+        assert_eq!(solved, Err(LinearError::TinyPivot(0)));
     }
 
     #[test]

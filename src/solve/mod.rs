@@ -11,6 +11,8 @@ pub mod floquet;
 mod integrator;
 pub mod linear;
 pub mod modes;
+mod ordering;
+mod pivot_free;
 mod steady;
 
 pub use integrator::{Integrator, Linearization, Stop};

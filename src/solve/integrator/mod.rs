@@ -77,7 +77,10 @@ pub struct Integrator<'s> {
     /// FET: the joints' residual at the end configuration.
     end_res: Residual,
     asm: Assembler,
+    /// The iteration matrix's pivot-free LU.
     lu: SparseLu,
+    /// The constrained mass matrix's (the start), with pivoting, made on first use.
+    mass_lu: Option<SparseLu>,
     /// `T^T J T` on the blocks: rotation unknowns with `H(c)` (conformal), or translation and
     /// rotation unknowns of each node with `R` (incremental, SE(3)).
     transform: Transform,
@@ -125,8 +128,8 @@ impl<'s> Integrator<'s> {
             entity: None,
             detail,
         };
-        let lu = SparseLu::new(&asm.pattern)
-            .map_err(|e| setup(format!("the sparse LU could not be set up ({e:?})")))?;
+        let late: Vec<bool> = sys.unknowns.iter().map(|k| k.is_multiplier()).collect();
+        let lu = SparseLu::pivot_free(&asm.pattern, &late);
         // FET integrates rotations incrementally (THEORY §8.1) whatever the treatment.
         let layout = match (set.method, set.rotations) {
             (Method::Fet, _) => Layout::Physical,
@@ -164,6 +167,7 @@ impl<'s> Integrator<'s> {
             end_res: Residual::new(n),
             asm,
             lu,
+            mass_lu: None,
             transform,
             mats: vec![M3::identity(); blocks.len()],
             cols: vec![M3::identity(); blocks.len()],
@@ -240,7 +244,10 @@ impl<'s> Integrator<'s> {
     fn singular(&self, e: LinearError) -> StepFailure {
         StepFailure {
             kind: FailureKind::Singular,
-            entity: None,
+            entity: match e {
+                LinearError::TinyPivot(i) => Some(self.sys.owners[i]),
+                _ => None,
+            },
             detail: format!("the iteration matrix could not be factored ({e:?}); a body may lack mass in some direction, or joints may be redundant"),
         }
     }

@@ -9,6 +9,7 @@ use super::{Integrator, Layout, StepFailure};
 use crate::runtime::rotation::{self as rot, V3};
 use crate::runtime::{Rate, State, UnknownKind};
 use crate::settings::{Method, Start};
+use crate::solve::linear::SparseLu;
 use crate::solve::{FailureKind, Notice, NoticeKind, RunStats, RuntimeFailure};
 
 impl Integrator<'_> {
@@ -22,8 +23,14 @@ impl Integrator<'_> {
         loop {
             self.start
                 .assemble(&mut self.asm, self.sys, &self.trial, self.aug);
-            let solved = match self.lu.factor(&self.asm.values) {
-                Ok(()) => self.lu.solve(rhs_and_x),
+            // Massless directions are allowed here: faer's pivoting LU, made on first use.
+            if self.mass_lu.is_none() {
+                let lu = SparseLu::new(&self.asm.pattern).map_err(|e| self.singular(e))?;
+                self.mass_lu = Some(lu);
+            }
+            let lu = self.mass_lu.as_mut().expect("made above");
+            let solved = match lu.factor(&self.asm.values) {
+                Ok(()) => lu.solve(rhs_and_x),
                 Err(e) => Err(e),
             };
             match solved {
