@@ -201,7 +201,9 @@ impl SparseLu {
         if rhs.iter().all(|x| x.is_finite()) {
             Ok(())
         } else {
-            Err(self.tiny.map_or(LinearError::NonFinite, LinearError::TinyPivot))
+            Err(self
+                .tiny
+                .map_or(LinearError::NonFinite, LinearError::TinyPivot))
         }
     }
 }
@@ -405,7 +407,8 @@ mod tests {
         };
         let mut lu = SparseLu::pivot_free(&pattern, &[false, false]);
         for _ in 0..2 {
-            lu.factor(&[0.0, 1.0, 1.0, 0.0]).expect("pivoting factors it");
+            lu.factor(&[0.0, 1.0, 1.0, 0.0])
+                .expect("pivoting factors it");
             let mut x = [2.0, 3.0];
             lu.solve(&mut x).expect("solve");
             assert_eq!(x, [3.0, 2.0]);
