@@ -363,18 +363,28 @@ impl Joint {
         let nl = m0 + self.rows.len();
         k[..nl * nl].iter_mut().for_each(|x| *x = 0.0);
         let w = c.force_weight;
+        // The slots this joint assembles, with their local positions.
+        let mut live = [(0usize, 0usize); SLOTS];
+        let mut nlive = 0;
+        for (s, l) in map.iter().enumerate() {
+            if let Some(l) = l {
+                live[nlive] = (s, *l);
+                nlive += 1;
+            }
+        }
+        let live = &live[..nlive];
+        // Every row's geometric stiffness and the penalty's `p grad G grad G^T`, summed over
+        // the rows and assembled once with the weight `w c_q`.
+        let mut h = [[0.0; SLOTS]; SLOTS];
         for (r, row) in self.rows.iter().enumerate() {
             let m = m0 + r;
             let (gv, gr) = row.geom(&geo);
-            let f = row.drive().map_or(0.0, |f| f.eval(st.t));
             let lam = st.lambda[self.first + r];
-            let mut h = [[0.0; SLOTS]; SLOTS];
             if row.is_rate() {
                 row.hess(&geo, aug.s * lam, &mut h);
                 let mut h1 = [[0.0; SLOTS]; SLOTS];
                 row.hess(&geo, 1.0, &mut h1);
-                for (sj, lj) in map.iter().enumerate() {
-                    let Some(lj) = lj else { continue };
+                for &(sj, lj) in live {
                     let vh: f64 = (0..SLOTS).map(|si| geo.vel[si] * h1[si][sj]).sum();
                     // `rate_scale` is `1 / velocity` (the integrator's `beta h / gamma`): the
                     // row is `s (B + rate_scale position V^T H)`, a unit-weight `s B` in the
@@ -382,30 +392,28 @@ impl Joint {
                     k[m * nl + lj] = aug.s * (gr[sj] + aug.rate_scale * c.position * vh);
                 }
             } else {
-                let cv = gv - f;
-                row.hess(&geo, aug.s * lam + aug.p * cv, &mut h);
-                for (sj, lj) in map.iter().enumerate() {
-                    if let Some(lj) = lj {
-                        k[m * nl + lj] = aug.s * gr[sj];
-                    }
+                let f = row.drive().map_or(0.0, |f| f.eval(st.t));
+                row.hess(&geo, aug.s * lam + aug.p * (gv - f), &mut h);
+                for &(sj, lj) in live {
+                    k[m * nl + lj] = aug.s * gr[sj];
                 }
-                for (si, li) in map.iter().enumerate() {
-                    let Some(li) = li else { continue };
-                    for (sj, lj) in map.iter().enumerate() {
-                        if let Some(lj) = lj {
-                            k[li * nl + lj] += w * c.position * aug.p * gr[si] * gr[sj];
+                for &(si, _) in live {
+                    let g = aug.p * gr[si];
+                    if g != 0.0 {
+                        for &(sj, _) in live {
+                            h[si][sj] += g * gr[sj];
                         }
                     }
                 }
             }
-            for (si, li) in map.iter().enumerate() {
-                let Some(li) = li else { continue };
+            for &(si, li) in live {
                 k[li * nl + m] = w * aug.s * gr[si];
-                for (sj, lj) in map.iter().enumerate() {
-                    if let Some(lj) = lj {
-                        k[li * nl + lj] += w * c.position * h[si][sj];
-                    }
-                }
+            }
+        }
+        let wc = w * c.position;
+        for &(si, li) in live {
+            for &(sj, lj) in live {
+                k[li * nl + lj] += wc * h[si][sj];
             }
         }
     }
