@@ -49,6 +49,8 @@ pub struct PivotFree {
     pos: Vec<usize>,
     tmp: Vec<f64>,
     y: Vec<f64>,
+    /// A supernode's rows below, gathered (as long as the longest).
+    gather: Vec<f64>,
     /// The factored matrix (for the refinement's residual), the right-hand side and the
     /// residual.
     a: Vec<f64>,
@@ -159,6 +161,13 @@ impl PivotFree {
             pos,
             tmp: vec![0.0; tmp_len],
             y: vec![0.0; n],
+            gather: vec![
+                0.0;
+                (0..ns)
+                    .map(|s| e.rows_ptr[s + 1] - e.rows_ptr[s])
+                    .max()
+                    .unwrap_or(0)
+            ],
             a: vec![0.0; pattern.row_idx.len()],
             b: vec![0.0; n],
             r: vec![0.0; n],
@@ -325,17 +334,21 @@ impl PivotFree {
 
     /// `rhs <- U^-1 L^-1 rhs`, in the original numbering.
     fn substitute(&mut self, rhs: &mut [f64]) {
-        let y = &mut self.y;
+        let (y, g) = (&mut self.y, &mut self.gather);
         for (k, &o) in self.perm.iter().enumerate() {
             y[k] = rhs[o];
         }
         let ns = self.first.len() - 1;
+        // Forward: each supernode's own unknowns, then its rows below through one dense
+        // product and one scatter.
         for t in 0..ns {
             let f = self.first[t];
             let w = self.first[t + 1] - f;
             let rows = &self.rows[self.rows_ptr[t]..self.rows_ptr[t + 1]];
-            let ld = w + rows.len();
+            let (m, ld) = (rows.len(), w + rows.len());
             let l = &self.x[self.l_at[t]..self.l_at[t] + ld * w];
+            let g = &mut g[..m];
+            g.fill(0.0);
             for k in 0..w {
                 let yk = y[f + k];
                 if yk != 0.0 {
@@ -343,12 +356,16 @@ impl PivotFree {
                     for i in k + 1..w {
                         y[f + i] -= c[i] * yk;
                     }
-                    for (r, &i) in rows.iter().enumerate() {
-                        y[i] -= c[w + r] * yk;
+                    for (gi, ci) in g.iter_mut().zip(&c[w..]) {
+                        *gi += ci * yk;
                     }
                 }
             }
+            for (&i, gi) in rows.iter().zip(g.iter()) {
+                y[i] -= gi;
+            }
         }
+        // Backward: the rows below gathered once, then the diagonal block.
         for t in (0..ns).rev() {
             let f = self.first[t];
             let w = self.first[t + 1] - f;
@@ -356,11 +373,15 @@ impl PivotFree {
             let (m, ld) = (rows.len(), w + rows.len());
             let l = &self.x[self.l_at[t]..self.l_at[t] + ld * w];
             let ut = &self.x[self.u_at[t]..self.u_at[t] + m * w];
+            let g = &mut g[..m];
+            for (gi, &i) in g.iter_mut().zip(rows) {
+                *gi = y[i];
+            }
             for j in 0..w {
                 let s: f64 = ut[j * m..(j + 1) * m]
                     .iter()
-                    .zip(rows)
-                    .map(|(u, &i)| u * y[i])
+                    .zip(g.iter())
+                    .map(|(u, v)| u * v)
                     .sum();
                 y[f + j] -= s;
             }
