@@ -41,7 +41,7 @@ pub struct PivotFree {
     x: Vec<f64>,
     /// Where each stored entry of the matrix goes in `x`, and its new column.
     dest: Vec<usize>,
-    col: Vec<usize>,
+    new_of: Vec<usize>,
     /// The largest entry of each new column (and row), for the pivot test.
     scale: Vec<f64>,
     updates: Vec<Update>,
@@ -100,7 +100,7 @@ impl PivotFree {
                     .expect("the fill holds every entry")
             }
         };
-        let (mut dest, mut col) = (Vec::with_capacity(pattern.row_idx.len()), Vec::new());
+        let mut dest = Vec::with_capacity(pattern.row_idx.len());
         for j in 0..n {
             for &i in &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]] {
                 let (ni, nj) = (inv[i], inv[j]);
@@ -116,7 +116,6 @@ impl PivotFree {
                     u_at[s] + (local(s, nj) - w) + (ni - e.first[s]) * below(s).len()
                 };
                 dest.push(d);
-                col.push(nj);
             }
         }
         let (mut updates, mut updates_ptr, mut pos) = (Vec::new(), vec![0], Vec::new());
@@ -154,7 +153,7 @@ impl PivotFree {
             u_at,
             x: vec![0.0; size],
             dest,
-            col,
+            new_of: inv,
             scale: vec![0.0; n],
             updates,
             updates_ptr,
@@ -181,12 +180,16 @@ impl PivotFree {
         self.a.copy_from_slice(values);
         self.x.fill(0.0);
         self.scale.fill(0.0);
-        for ((&d, &c), &v) in self.dest.iter().zip(&self.col).zip(values) {
-            self.x[d] = v;
-            // Not f64::max: a NaN here shows as a NaN pivot, and this compiles to one maxsd.
-            let (a, m) = (v.abs(), &mut self.scale[c]);
-            if a > *m {
-                *m = a;
+        for (j, &c) in self.new_of.iter().enumerate() {
+            let (lo, hi) = (self.col_ptr[j], self.col_ptr[j + 1]);
+            let m = &mut self.scale[c];
+            for (&d, &v) in self.dest[lo..hi].iter().zip(&values[lo..hi]) {
+                self.x[d] = v;
+                // Not f64::max: a NaN here shows as a NaN pivot, and this compiles to maxsd.
+                let a = v.abs();
+                if a > *m {
+                    *m = a;
+                }
             }
         }
         for t in 0..self.first.len() - 1 {
