@@ -91,6 +91,10 @@ pub struct Integrator<'s> {
     cols: Vec<M3>,
     /// Unknowns moved by the SE(3) node updates instead of Newmark on coordinates.
     in_frame: Vec<bool>,
+    /// The step's increment so far: of each coordinate (not in a frame), and of each node's
+    /// frame (body-frame `(u, theta)`; rotation only for nodes that are not frames).
+    step_q: Vec<f64>,
+    step_frames: Vec<[f64; 6]>,
     /// The converged state at the current time.
     cur: State,
     /// The iterate of the step being solved.
@@ -174,6 +178,8 @@ impl<'s> Integrator<'s> {
             blocks,
             block_node,
             in_frame,
+            step_q: vec![0.0; n],
+            step_frames: vec![[0.0; 6]; nodes],
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
             rhs: vec![0.0; n],

@@ -96,7 +96,8 @@ impl Integrator<'_> {
             } else {
                 tr.lambda[i] = 0.0;
                 if !self.in_frame[i] {
-                    tr.q[i] = cur.q[i] + step(cur.v[i], cur.a[i], cur.alg[i]);
+                    self.step_q[i] = step(cur.v[i], cur.a[i], cur.alg[i]);
+                    tr.q[i] = cur.q[i] + self.step_q[i];
                 }
             }
         }
@@ -104,6 +105,12 @@ impl Integrator<'_> {
             for k in 0..self.sys.rotations.len() {
                 let f = cur.frames[k];
                 let d: [f64; 6] = std::array::from_fn(|j| step(f.v[j], f.dv[j], f.alg[j]));
+                // Non-frames' translations are coordinates, in `step_q`.
+                self.step_frames[k] = if self.sys.is_frame(k) {
+                    d
+                } else {
+                    [0.0, 0.0, 0.0, d[3], d[4], d[5]]
+                };
                 se3::displace(self.sys, cur, tr, k, &d);
             }
         }
@@ -187,21 +194,26 @@ impl Integrator<'_> {
         let n = self.sys.len();
         let conformal = self.layout == Layout::Conformal;
         let mut dmax = 0.0f64;
-        let tr = &mut self.trial;
+        let (cur, tr) = (&self.cur, &mut self.trial);
+        // Coordinates move by the step's increment, kept apart (see `se3::compose`).
         for i in 0..n {
             let d = self.rhs[i];
+            let shift = |q: &mut [f64], step: &mut [f64]| {
+                step[i] += d;
+                q[i] = cur.q[i] + step[i];
+            };
             match self.sys.unknowns[i] {
                 UnknownKind::Multiplier | UnknownKind::RateMultiplier => tr.lambda[i] += d,
                 UnknownKind::Rotation { .. } => {
                     dmax = dmax.max(d.abs());
                     if conformal {
-                        tr.q[i] += d;
+                        shift(&mut tr.q, &mut self.step_q);
                     }
                 }
                 UnknownKind::Coordinate => {
                     dmax = dmax.max(d.abs() / self.sys.length_scale);
                     if !self.in_frame[i] {
-                        tr.q[i] += d;
+                        shift(&mut tr.q, &mut self.step_q);
                     }
                 }
             }
@@ -223,7 +235,8 @@ impl Integrator<'_> {
                     rhs[r + 1],
                     rhs[r + 2],
                 ];
-                se3::displace_in_place(self.sys, tr, k, &d);
+                self.step_frames[k] = se3::compose(self.sys, k, &self.step_frames[k], &d);
+                se3::displace(self.sys, cur, tr, k, &self.step_frames[k]);
             }
         }
         self.newmark(h);
@@ -311,7 +324,7 @@ impl Integrator<'_> {
             if self.in_frame[i] || self.sys.unknowns[i].is_multiplier() {
                 continue;
             }
-            let (v, a, alg) = relation(tr.q[i] - cur.q[i], cur.v[i], cur.a[i], cur.alg[i]);
+            let (v, a, alg) = relation(self.step_q[i], cur.v[i], cur.a[i], cur.alg[i]);
             (tr.v[i], tr.a[i], tr.alg[i]) = (v, a, alg);
         }
         if self.layout == Layout::Conformal {
@@ -319,7 +332,7 @@ impl Integrator<'_> {
             return;
         }
         for k in 0..self.sys.rotations.len() {
-            let d = se3::increment(self.sys, cur, tr, k);
+            let d = self.step_frames[k];
             let f0 = cur.frames[k];
             let f = &mut tr.frames[k];
             for j in 0..6 {

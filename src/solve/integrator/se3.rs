@@ -11,7 +11,7 @@
 //! Nodes that are not frames (`System::is_frame`, beam nodes) keep only the rotational half:
 //! `R <- R exp(dtheta*)` with Newmark on `R^T omega`, their translations being coordinates.
 
-use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, log, M3, V3};
+use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, M3, V3};
 use crate::runtime::{State, System};
 
 fn x_of(st: &State, t: usize) -> V3 {
@@ -66,18 +66,6 @@ pub fn to_physical(sys: &System, st: &mut State, k: usize) {
     st.rot[k].dw = omd.into();
 }
 
-/// The body-frame increment `log(H_from^-1 H_to)` of node `k`.
-pub fn increment(sys: &System, from: &State, to: &State, k: usize) -> [f64; 6] {
-    let t = sys.translations[k];
-    let r0 = from.rot[k].matrix();
-    let th = log(&(r0.transpose() * to.rot[k].matrix()));
-    if !sys.is_frame(k) {
-        return join(&V3::zeros(), &th);
-    }
-    let u = left_jacobian_inverse(&th) * (r0.transpose() * (x_of(to, t) - x_of(from, t)));
-    join(&u, &th)
-}
-
 /// `H <- H_from exp(d)` for node `k`, written into `to`.
 pub fn displace(sys: &System, from: &State, to: &mut State, k: usize, d: &[f64; 6]) {
     let t = sys.translations[k];
@@ -92,16 +80,39 @@ pub fn displace(sys: &System, from: &State, to: &mut State, k: usize, d: &[f64; 
     to.rot[k].set_matrix(&(r0 * exp(&th)));
 }
 
-/// `H <- H exp(d)` for node `k` of `st` in place.
-pub fn displace_in_place(sys: &System, st: &mut State, k: usize, d: &[f64; 6]) {
-    let t = sys.translations[k];
-    let (u, th) = split(d);
-    let r0: M3 = st.rot[k].matrix();
-    if sys.is_frame(k) {
-        let x = x_of(st, t) + r0 * (left_jacobian(&th) * u);
-        for i in 0..3 {
-            st.q[t + i] = x[i];
-        }
+/// The rotation vector of `exp(a) exp(b)`, through unit quaternions: every quantity stays as
+/// small as the rotations, so the result is accurate relative to them (`log(exp(a) exp(b))`
+/// through matrices would carry an absolute round-off of `1e-16` rad).
+fn compose_rotations(a: &V3, b: &V3) -> V3 {
+    let half = |v: &V3| {
+        let t = v.norm();
+        let (s, c) = (0.5 * t).sin_cos();
+        let k = if t > 1e-6 { s / t } else { 0.5 - t * t / 48.0 };
+        (c, v * k)
+    };
+    let ((wa, va), (wb, vb)) = (half(a), half(b));
+    let (mut w, mut v) = (wa * wb - va.dot(&vb), vb * wa + va * wb + va.cross(&vb));
+    if w < 0.0 {
+        (w, v) = (-w, -v);
     }
-    st.rot[k].set_matrix(&(r0 * exp(&th)));
+    let sn = v.norm();
+    if sn == 0.0 {
+        return V3::zeros();
+    }
+    v * (2.0 * sn.atan2(w) / sn)
+}
+
+/// The body-frame increment `log(exp(d0) exp(d))` of node `k` after a correction `d` of the
+/// step's increment `d0`, composed from the increments alone: the step's increment then
+/// never comes from differences of the coordinates (metres from the origin, rotations of many
+/// turns), whose round-off `1/(beta h^2)` would amplify into the accelerations. Nodes that are
+/// not frames compose their rotation only.
+pub fn compose(sys: &System, k: usize, d0: &[f64; 6], d: &[f64; 6]) -> [f64; 6] {
+    let ((u0, t0), (u, t)) = (split(d0), split(d));
+    let th = compose_rotations(&t0, &t);
+    if !sys.is_frame(k) {
+        return join(&V3::zeros(), &th);
+    }
+    let p = left_jacobian(&t0) * u0 + exp(&t0) * (left_jacobian(&t) * u);
+    join(&(left_jacobian_inverse(&th) * p), &th)
 }
