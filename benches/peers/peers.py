@@ -258,28 +258,20 @@ def study(p, rows, quick):
         print("  " + n)
 
     pts = {"mbd": [], "Exudyn": []}
-    for dt, r in zip(dts, ladder_m):
-        if r is None:
-            rows.append(dict(problem=p["name"], code="mbd", dt=dt,
-                             steps=int(round(p["until"] / dt)), rel_error="failed",
-                             solve_cpu_s="", process_cpu_s="", build_cpu_s="", newton=""))
-            continue
-        e = rel_error(r[0], ref)
-        pts["mbd"].append((r[1], e))
-        rows.append(dict(problem=p["name"], code="mbd", dt=dt, steps=int(round(p["until"] / dt)),
-                         rel_error=e, solve_cpu_s=r[1], process_cpu_s=r[2], build_cpu_s="",
-                         newton=r[3]))
-    for dt, r in zip(dts, ladder_e):
-        if r is None:
-            rows.append(dict(problem=p["name"], code="Exudyn", dt=dt,
-                             steps=int(round(p["until"] / dt)), rel_error="failed",
-                             solve_cpu_s="", process_cpu_s="", build_cpu_s="", newton=""))
-            continue
-        e = rel_error(r[0], ref)
-        pts["Exudyn"].append((r[1], e))
-        rows.append(dict(problem=p["name"], code="Exudyn", dt=dt,
-                         steps=int(round(p["until"] / dt)), rel_error=e, solve_cpu_s=r[1],
-                         process_cpu_s="", build_cpu_s=r[2], newton=""))
+    for code, ladder in (("mbd", ladder_m), ("Exudyn", ladder_e)):
+        for dt, r in zip(dts, ladder):
+            steps = int(round(p["until"] / dt))
+            row = dict(problem=p["name"], code=code, dt=dt, steps=steps)
+            if r is None:
+                rows.append(dict(row, rel_error="failed", solve_cpu_s="", process_cpu_s="",
+                                 build_cpu_s="", newton=""))
+                continue
+            e = rel_error(r[0], ref)
+            pts[code].append((r[1], e))
+            # mbd: (csv, solve, process, newton); Exudyn: (csv, solve, build).
+            extra = (dict(process_cpu_s=r[2], build_cpu_s="", newton=r[3]) if code == "mbd"
+                     else dict(process_cpu_s="", build_cpu_s=r[2], newton=""))
+            rows.append(dict(row, rel_error=e, solve_cpu_s=r[1], **extra))
     print(f"  {'dt [s]':>11} {'mbd error':>11} {'mbd solve':>11} {'mbd proc':>10} "
           f"{'Exu error':>11} {'Exu solve':>11} {'Exu build':>10}")
     for dt in dts:
