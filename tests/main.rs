@@ -17,6 +17,7 @@ mod loads;
 mod mbc;
 mod models;
 mod modes;
+mod newton;
 mod outputs;
 mod pendulum;
 mod reference;

@@ -5,7 +5,7 @@
 use super::progress::Steps;
 use super::{compile, read, report, runnable, sink, to_path, usage, Format, EXIT_RUNTIME};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
-use mbd::settings::{Method, Request, Rotations, Start};
+use mbd::settings::{Method, NewtonMode, Request, Rotations, Start};
 use std::process::ExitCode;
 
 #[derive(clap::Args)]
@@ -45,6 +45,10 @@ pub struct RunArgs {
     /// Initial accelerations: consistent (default) or zero (the paper's start).
     #[arg(long, value_parser = choice(&Start::FLAGS))]
     start: Option<Start>,
+    /// Newton's iteration matrix: full (default: new every iteration), modified (kept while
+    /// Newton contracts twofold) or auto (kept while it contracts fivefold, where that pays).
+    #[arg(long, value_parser = choice(&NewtonMode::FLAGS))]
+    newton: Option<NewtonMode>,
     /// Diagnostics format.
     #[arg(long, value_enum, default_value = "human")]
     format: Format,
@@ -75,6 +79,7 @@ impl RunArgs {
             until: self.until,
             every: self.every,
             start: self.start,
+            newton: self.newton,
             ..Request::default()
         }
     }
@@ -108,10 +113,11 @@ pub fn run(a: RunArgs) -> ExitCode {
             report(&r.warnings, &c.sources, format);
             if format == Format::Human {
                 eprintln!(
-                    "{}: {} steps, {} Newton iterations, {} halvings, max |C| {:.2e} m, {} rows{} in {:.1} ms",
+                    "{}: {} steps, {} Newton iterations ({} factorizations), {} halvings, max |C| {:.2e} m, {} rows{} in {:.1} ms",
                     c.model.name,
                     r.stats.steps,
                     r.stats.newton_iterations,
+                    r.stats.factorizations,
                     r.stats.halvings,
                     r.stats.max_constraint_violation,
                     r.rows,

@@ -251,6 +251,22 @@ impl State {
         }
     }
 
+    /// Becomes a copy of `other` (of the same size) without allocating.
+    pub fn assign(&mut self, other: &State) {
+        self.t = other.t;
+        for (a, b) in [
+            (&mut self.q, &other.q),
+            (&mut self.v, &other.v),
+            (&mut self.a, &other.a),
+            (&mut self.lambda, &other.lambda),
+            (&mut self.alg, &other.alg),
+        ] {
+            a.copy_from_slice(b);
+        }
+        self.rot.copy_from_slice(&other.rot);
+        self.frames.copy_from_slice(&other.frames);
+    }
+
     /// The first unknown holding a non-finite value, if any.
     pub fn first_non_finite(&self) -> Option<usize> {
         (0..self.q.len()).find(|&i| {

@@ -13,87 +13,8 @@ use crate::diagnostics::{did_you_mean, Code, Diagnostic};
 use crate::source::Span;
 use serde::Serialize;
 
-/// The time integrator.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Method {
-    /// HHT-alpha (THEORY §7.2), in the Arnold-Bruls form.
-    #[default]
-    Hht,
-    /// Generalized-alpha, Arnold-Bruls form (THEORY §7.5).
-    GeneralizedAlpha,
-    /// Time finite elements: the bilinear mixed element with midpoint quadrature (THEORY §8.1).
-    Fet,
-    /// Static equilibrium at each step's time: steps are load steps (loads and prescribed
-    /// motions as functions of time), no inertia.
-    Static,
-}
-
-impl Method {
-    /// Every method, with its name in a `solve` block (`solve hht { .. }`).
-    pub const NAMES: [(&'static str, Method); 4] = [
-        ("hht", Method::Hht),
-        ("generalized_alpha", Method::GeneralizedAlpha),
-        ("fet", Method::Fet),
-        ("static", Method::Static),
-    ];
-
-    /// Every method, with its name on the command line (`--integrator generalized-alpha`).
-    pub const FLAGS: [(&'static str, Method); 4] = [
-        ("hht", Method::Hht),
-        ("generalized-alpha", Method::GeneralizedAlpha),
-        ("fet", Method::Fet),
-        ("static", Method::Static),
-    ];
-
-    pub fn parse(name: &str) -> Option<Method> {
-        Self::NAMES
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(_, m)| *m)
-    }
-}
-
-/// How rotations are integrated (THEORY §2.7, §7.1).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Rotations {
-    /// Stored rotation matrices updated by incremental rotations (rigid bodies as SE(3)
-    /// frames); never rescales.
-    #[default]
-    Incremental,
-    /// The paper's: the total conformal rotation vector is the unknown, Newmark on `c`,
-    /// `c-dot`, `c-ddot`, rescaled when `|c| > 4` (past pi).
-    Conformal,
-}
-
-impl Rotations {
-    /// Every treatment, with its name in a `solve` block and on the command line.
-    pub const FLAGS: [(&'static str, Rotations); 2] = [
-        ("incremental", Rotations::Incremental),
-        ("conformal", Rotations::Conformal),
-    ];
-}
-
-/// How the first step starts.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Start {
-    /// Accelerations and multipliers solved from the equations at t = 0 (THEORY §7.3).
-    #[default]
-    Consistent,
-    /// Zero accelerations and multipliers, as the paper did (its Fig. 8).
-    ZeroAcceleration,
-}
-
-impl Start {
-    /// Every start, with its name on the command line (`--start zero`; in a `solve` block
-    /// `start = zero_acceleration`).
-    pub const FLAGS: [(&'static str, Start); 2] = [
-        ("consistent", Start::Consistent),
-        ("zero", Start::ZeroAcceleration),
-    ];
-}
+mod options;
+pub use options::{Method, NewtonMode, Rotations, Start, AUTO_RATE, MODIFIED_RATE};
 
 /// A closed range of a real setting, its default and how it is written in messages.
 #[derive(Clone, Copy, Debug)]
@@ -173,6 +94,8 @@ pub struct Settings {
     /// How many times a failing step is halved before the run fails: [`HALVINGS`] = 3, and
     /// [`STATIC_HALVINGS`] = 4 for statics (not settable).
     pub max_halvings: usize,
+    /// How the iteration matrix is kept. Default auto.
+    pub newton: NewtonMode,
 }
 
 impl Default for Settings {
@@ -192,6 +115,7 @@ impl Default for Settings {
             residual_tolerance: RESIDUAL_TOLERANCE,
             max_iterations: MAX_ITERATIONS_DEFAULT,
             max_halvings: HALVINGS,
+            newton: NewtonMode::Auto,
         }
     }
 }
@@ -210,6 +134,7 @@ pub enum Field {
     Start,
     Tolerance,
     MaxIterations,
+    Newton,
 }
 
 /// What a setting's value is, for the model stage to evaluate it.
@@ -227,7 +152,7 @@ pub enum Kind {
 
 impl Field {
     /// The settings a `solve` block's properties may give (the method is its header).
-    pub const IN_BLOCK: [Field; 10] = [
+    pub const IN_BLOCK: [Field; 11] = [
         Field::Alpha,
         Field::RhoInf,
         Field::Rotations,
@@ -238,6 +163,7 @@ impl Field {
         Field::Start,
         Field::Tolerance,
         Field::MaxIterations,
+        Field::Newton,
     ];
 
     /// The property's name in a `solve` block.
@@ -254,6 +180,7 @@ impl Field {
             Field::Start => "start",
             Field::Tolerance => "tolerance",
             Field::MaxIterations => "max_iterations",
+            Field::Newton => "newton",
         }
     }
 
@@ -271,12 +198,13 @@ impl Field {
             Field::Start => "--start",
             Field::Tolerance => "--tolerance",
             Field::MaxIterations => "--max-iterations",
+            Field::Newton => "--newton",
         }
     }
 
     pub fn kind(self) -> Kind {
         match self {
-            Field::Method | Field::Rotations | Field::Start => Kind::Choice,
+            Field::Method | Field::Rotations | Field::Start | Field::Newton => Kind::Choice,
             Field::Dt | Field::Until => Kind::Time,
             Field::Alpha | Field::RhoInf | Field::Tolerance => Kind::Number,
             Field::Steps | Field::Every | Field::MaxIterations => Kind::Count,
@@ -299,6 +227,7 @@ pub struct Request {
     pub start: Option<Start>,
     pub tolerance: Option<f64>,
     pub max_iterations: Option<usize>,
+    pub newton: Option<NewtonMode>,
 }
 
 /// A setting's value that is out of its range.
@@ -415,6 +344,10 @@ impl Request {
                 _ => None,
             }
             .map(|s| self.start = Some(s)),
+            Field::Newton => NewtonMode::FLAGS
+                .iter()
+                .find(|(n, _)| *n == w)
+                .map(|(_, m)| self.newton = Some(*m)),
             _ => None,
         };
         if known.is_some() {
@@ -431,6 +364,7 @@ impl Request {
                     .hint(hint)
             }
             Field::Rotations => Diagnostic::error(Code::E0211, "unknown rotation treatment").at(span, "not a rotation treatment").hint("`rotations = incremental` (default: stored rotations, incremental parameters) or `rotations = conformal` (the paper's total conformal rotation vector, rescaled past pi)"),
+            Field::Newton => Diagnostic::error(Code::E0211, "unknown Newton mode").at(span, "not a Newton mode").hint("`newton = full` (default: a new matrix every iteration), `newton = modified` (kept while Newton contracts twofold an iteration) or `newton = auto` (kept while it contracts fivefold, where that costs less)"),
             _ => Diagnostic::error(Code::E0211, "unknown start").at(span, "not a start option").hint("`start = consistent` (default) or `start = zero_acceleration` (the paper's start)"),
         })
     }
@@ -448,7 +382,7 @@ impl Request {
             Field::Steps => self.steps = count,
             Field::Every => self.every = count,
             Field::MaxIterations => self.max_iterations = count,
-            Field::Method | Field::Rotations | Field::Start => {}
+            Field::Method | Field::Rotations | Field::Start | Field::Newton => {}
         }
     }
 
@@ -471,6 +405,7 @@ impl Request {
             start: over.start.or(self.start),
             tolerance: over.tolerance.or(self.tolerance),
             max_iterations: over.max_iterations.or(self.max_iterations),
+            newton: over.newton.or(self.newton),
         }
     }
 }
@@ -563,6 +498,7 @@ impl Settings {
             } else {
                 HALVINGS
             },
+            newton: r.newton.unwrap_or_default(),
         })
     }
 

@@ -190,11 +190,22 @@ impl SparseLu {
 
     /// Solves `A x = rhs` in place with the last factorization.
     pub fn solve(&mut self, rhs: &mut [f64]) -> Result<(), LinearError> {
+        self.solve_with(rhs, true)
+    }
+
+    /// As [`SparseLu::solve`], without the pivot-free factorization's refinement: for an
+    /// iteration that refines the solution itself (Newton with a kept matrix).
+    pub fn solve_unrefined(&mut self, rhs: &mut [f64]) -> Result<(), LinearError> {
+        self.solve_with(rhs, false)
+    }
+
+    fn solve_with(&mut self, rhs: &mut [f64], refine: bool) -> Result<(), LinearError> {
         if !self.factored {
             return Err(LinearError::Singular);
         }
         match (&mut self.fast, &mut self.pivoting) {
-            (Some(fast), _) if self.tiny.is_none() => fast.solve(rhs),
+            (Some(fast), _) if self.tiny.is_none() && refine => fast.solve(rhs),
+            (Some(fast), _) if self.tiny.is_none() => fast.substitute(rhs),
             (_, Some(p)) => p.solve(rhs),
             _ => return Err(LinearError::Singular),
         }

@@ -64,6 +64,9 @@ pub struct RunStats {
     pub steps: usize,
     pub newton_iterations: usize,
     pub halvings: usize,
+    /// Numeric factorizations of the iteration matrix (one per Newton iteration with
+    /// `newton = full`; fewer when the matrix is kept).
+    pub factorizations: usize,
     /// Changes of state of conformal rotation vectors (conformal treatment only).
     pub rescalings: usize,
     /// Largest |C| over all steps [m].

@@ -336,7 +336,7 @@ impl PivotFree {
     }
 
     /// `rhs <- U^-1 L^-1 rhs`, in the original numbering.
-    fn substitute(&mut self, rhs: &mut [f64]) {
+    pub fn substitute(&mut self, rhs: &mut [f64]) {
         let (y, g) = (&mut self.y, &mut self.gather);
         for (k, &o) in self.perm.iter().enumerate() {
             y[k] = rhs[o];

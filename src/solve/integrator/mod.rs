@@ -26,9 +26,9 @@ use super::linear::{LinearError, SparseLu};
 use super::{FailureKind, RunStats, RuntimeFailure};
 use crate::runtime::rotation::{M3, V3};
 use crate::runtime::{Assembler, Augment, Residual, State, System};
-use crate::settings::{Method, Rotations, Settings};
+use crate::settings::{Method, NewtonMode, Rotations, Settings};
 use newmark::Scheme;
-use newton::Newton;
+use newton::{Newton, Reuse};
 use rotations::Transform;
 use start_matrix::StartMetric;
 
@@ -77,8 +77,18 @@ pub struct Integrator<'s> {
     /// FET: the joints' residual at the end configuration.
     end_res: Residual,
     asm: Assembler,
-    /// The iteration matrix's pivot-free LU.
+    /// The iteration matrix's pivot-free LU, and the step size it was made for while it may be
+    /// kept (`newton = modified | auto`); `None` when it must be made anew.
     lu: SparseLu,
+    kept: Option<f64>,
+    /// The iterate (and FET's mid-configuration) before a correction by a kept matrix.
+    saved: (State, State),
+    /// The multipliers of the step before the current one, and the size of the last two steps
+    /// when they were equal.
+    lambda_prev: (Vec<f64>, Option<f64>),
+    last_h: Option<f64>,
+    /// Whether each step may keep the matrix (`newton = auto` decides step by step).
+    reuse: Reuse,
     /// The constrained mass matrix's (the start), with pivoting, made on first use.
     mass_lu: Option<SparseLu>,
     /// `T^T J T` on the blocks: rotation unknowns with `H(c)` (conformal), or translation and
@@ -171,6 +181,11 @@ impl<'s> Integrator<'s> {
             end_res: Residual::new(n),
             asm,
             lu,
+            kept: None,
+            saved: (sys.initial.clone(), sys.initial.clone()),
+            reuse: Reuse::new(set.newton, set.method),
+            lambda_prev: (vec![0.0; n], None),
+            last_h: None,
             mass_lu: None,
             transform,
             mats: vec![M3::identity(); blocks.len()],
@@ -308,6 +323,8 @@ impl<'s> Integrator<'s> {
             Err(f) if depth >= self.set.max_halvings => Err(f),
             Err(_) => {
                 self.stats.halvings += 1;
+                self.last_h = None;
+                self.kept = None;
                 // Failure path only: keep a copy to restore if the halves fail too.
                 let backup = (self.cur.clone(), self.aug);
                 let result = self
@@ -351,37 +368,89 @@ impl<'s> Integrator<'s> {
         }
     }
 
+    /// The residual at the iterate by the method, and its norms.
+    fn residual(
+        &mut self,
+        fet: bool,
+        h: f64,
+        aug: Augment,
+        floor: f64,
+    ) -> Result<Norms, StepFailure> {
+        if fet {
+            self.fet_residual(h, aug, floor)
+        } else {
+            self.newmark_residual(aug, floor)
+        }
+    }
+
+    /// The iteration matrix at the iterate, factored; kept for steps of `h` when the settings
+    /// allow.
+    fn refactor(&mut self, h: f64, aug: Augment, fet: bool) -> Result<(), StepFailure> {
+        self.kept = None;
+        if fet {
+            self.fet_matrix(h, aug);
+        } else {
+            self.newmark_matrix(h, aug);
+        }
+        self.lu
+            .factor(&self.asm.values)
+            .map_err(|e| self.singular(e))?;
+        self.stats.factorizations += 1;
+        if self.set.newton != NewtonMode::Full {
+            self.kept = Some(h);
+        }
+        Ok(())
+    }
+
+    /// The step's end: the counts, and the converged iterate made current.
+    fn converge(&mut self, it: usize, cnorm: f64, aug: Augment, h: f64) -> Result<(), StepFailure> {
+        self.stats.newton_iterations += it;
+        self.stats.max_constraint_violation = self.stats.max_constraint_violation.max(cnorm);
+        self.aug = aug;
+        self.lambda_prev.0.copy_from_slice(&self.cur.lambda);
+        self.lambda_prev.1 = (self.last_h == Some(h)).then_some(h);
+        self.last_h = Some(h);
+        if self.method == Method::Fet {
+            self.fet_commit(h)
+        } else {
+            self.newmark_commit()
+        }
+    }
+
     /// One step of size `h` from `cur` by the method's Newton iteration; on success `cur`
     /// holds the new state.
     fn attempt(&mut self, h: f64) -> Result<(), StepFailure> {
         let aug = self.scaling(h);
         let rescale = self.aug.s / aug.s;
         let fet = self.method == Method::Fet;
+        let keep_rate = self.reuse.begin();
+        let factorizations = self.stats.factorizations;
         if fet {
             self.fet_predict(h, rescale);
         } else {
-            self.newmark_predict(h, rescale);
+            self.newmark_predict(h, rescale, keep_rate > 0.0);
         }
         let mut newton = Newton::new(&self.set, self.sys);
         let max = self.set.max_iterations;
+        // Whether the last correction came from a kept matrix, and the residual's total
+        // before it.
+        let (mut after_kept, mut last_total) = (false, f64::INFINITY);
         for it in 0..=max {
-            let r = if fet {
-                self.fet_residual(h, aug, newton.floor)?
-            } else {
-                self.newmark_residual(aug, newton.floor)?
-            };
-            if newton.converged(r.force, r.scale, r.constraint) {
-                self.stats.newton_iterations += it;
-                self.stats.max_constraint_violation =
-                    self.stats.max_constraint_violation.max(r.constraint);
-                self.aug = aug;
-                return if fet {
-                    self.fet_commit(h)
-                } else {
-                    self.newmark_commit()
-                };
+            let mut r = self.residual(fet, h, aug, newton.floor)?;
+            let mut total = r.force + aug.s * r.constraint;
+            // A kept matrix's correction that made the residual grow is taken back, and a new
+            // matrix made at the iterate before it.
+            let rejected = after_kept && total > last_total;
+            if rejected {
+                self.trial.assign(&self.saved.0);
+                self.mid.assign(&self.saved.1);
+                r = self.residual(fet, h, aug, newton.floor)?;
+                total = r.force + aug.s * r.constraint;
+            } else if newton.converged(r.force, r.scale, r.constraint) {
+                self.reuse
+                    .end(it, self.stats.factorizations - factorizations);
+                return self.converge(it, r.constraint, aug, h);
             }
-            let total = r.force + aug.s * r.constraint;
             let what = if fet { " of the time element" } else { "" };
             let norms = (r.force, r.scale, r.constraint);
             if let Some(detail) = newton.check(it, max, total, norms, what) {
@@ -391,15 +460,17 @@ impl<'s> Integrator<'s> {
                     detail,
                 });
             }
-            if fet {
-                self.fet_matrix(h, aug);
+            let fresh = rejected || self.kept != Some(h) || newton.rate() > keep_rate;
+            if fresh {
+                self.refactor(h, aug, fet)?;
+                self.lu.solve(&mut self.rhs)
             } else {
-                self.newmark_matrix(h, aug);
+                self.saved.0.assign(&self.trial);
+                self.saved.1.assign(&self.mid);
+                // Newton's next iteration refines a kept matrix's solution.
+                self.lu.solve_unrefined(&mut self.rhs)
             }
-            self.lu
-                .factor(&self.asm.values)
-                .map_err(|e| self.singular(e))?;
-            self.lu.solve(&mut self.rhs).map_err(|e| self.singular(e))?;
+            .map_err(|e| self.singular(e))?;
             if self.layout != Layout::Conformal {
                 self.limit_turn();
             }
@@ -408,7 +479,8 @@ impl<'s> Integrator<'s> {
             } else {
                 self.newmark_correct(h)
             };
-            newton.record(dmax);
+            newton.record(dmax, fresh);
+            (after_kept, last_total) = (!fresh, total);
         }
         Err(StepFailure {
             kind: FailureKind::NewtonDiverged,

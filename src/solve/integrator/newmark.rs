@@ -76,8 +76,12 @@ impl Scheme {
 impl Integrator<'_> {
     /// Predictor: the acceleration `a_{n+1} = a_n` (statics: the previous load step's
     /// equilibrium); the multipliers carried over at the new scaling.
-    pub(super) fn newmark_predict(&mut self, h: f64, rescale: f64) {
+    pub(super) fn newmark_predict(&mut self, h: f64, rescale: f64, extrapolate: bool) {
         let sc = self.sc;
+        // A kept matrix corrects the multipliers slowly (joint forces in inertial components
+        // turn with the bodies, by about `omega h` a step): they start from their linear
+        // extrapolation over the last two steps of this size.
+        let extrapolate = extrapolate && self.lambda_prev.1 == Some(h);
         let hold = self.method == Method::Static;
         let n = self.sys.len();
         let (cur, tr) = (&self.cur, &mut self.trial);
@@ -92,7 +96,11 @@ impl Integrator<'_> {
         };
         for i in 0..n {
             if self.sys.unknowns[i].is_multiplier() {
-                tr.lambda[i] = cur.lambda[i] * rescale;
+                tr.lambda[i] = if extrapolate {
+                    2.0 * cur.lambda[i] - self.lambda_prev.0[i]
+                } else {
+                    cur.lambda[i] * rescale
+                };
             } else {
                 tr.lambda[i] = 0.0;
                 if !self.in_frame[i] {
