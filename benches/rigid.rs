@@ -1,23 +1,46 @@
 //! Benchmarks of the rigid runtime: the two-bar runs of P3 (1,000 steps) and P4 under each
-//! rotation treatment of HHT, and under time finite elements. Per-step cost = the median divided by 1,000; Newton iterations per step
+//! rotation treatment of HHT, with HHT's matrix kept (`newton = auto`), and under time
+//! finite elements. Per-step cost = the median divided by 1,000; Newton iterations per step
 //! are printed once before timing.
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbd::settings::{Method, Request, Rotations};
+use mbd::settings::{Method, NewtonMode, Request, Rotations};
 
 mod common;
 
 fn runs(c: &mut Criterion) {
     for model in ["two_bar.mbd", "two_bar_spin.mbd", "pendulum.mbd"] {
         let source = common::model_text(model);
-        for (name, rotations, integrator) in [
-            ("incremental", Rotations::Incremental, Method::Hht),
-            ("conformal", Rotations::Conformal, Method::Hht),
-            ("fet", Rotations::Incremental, Method::Fet),
+        for (name, rotations, integrator, newton) in [
+            (
+                "incremental rotations",
+                Rotations::Incremental,
+                Method::Hht,
+                NewtonMode::Full,
+            ),
+            (
+                "conformal rotations",
+                Rotations::Conformal,
+                Method::Hht,
+                NewtonMode::Full,
+            ),
+            (
+                "fet rotations",
+                Rotations::Incremental,
+                Method::Fet,
+                NewtonMode::Full,
+            ),
+            (
+                "incremental rotations, newton auto",
+                Rotations::Incremental,
+                Method::Hht,
+                NewtonMode::Auto,
+            ),
         ] {
             let o = Request {
                 rotations: Some(rotations),
                 method: Some(integrator),
+                newton: Some(newton),
                 ..Request::default()
             };
             let Ok(compiled) = mbd::compile(model, &source, &[], o) else {
@@ -33,7 +56,7 @@ fn runs(c: &mut Criterion) {
                 ),
                 Err(f) => eprintln!("{model} {name}: failed ({})", f.diagnostic.message),
             }
-            c.bench_function(&format!("{model}: run, {name} rotations"), |b| {
+            c.bench_function(&format!("{model}: run, {name}"), |b| {
                 b.iter(|| {
                     out.clear();
                     mbd::run(&compiled, &mut out).is_ok()

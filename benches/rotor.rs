@@ -1,25 +1,32 @@
 //! Benchmarks of the rotor analyses on the windmill (P5): the paper's 3 s run (6,000 steps of
 //! HHT -0.1), and one point of a stability sweep by each method at Omega_bar = 1.5 (Floquet:
-//! 21 runs of one period, 1,396 steps each; Prony: the 3 s run and the matrix-pencil fit). A
-//! 50-point sweep costs about 50 Floquet points over the cores; its wall time is measured by
-//! `mbd stability` itself (see the closing note of issue 7).
+//! 21 runs of one period, 1,396 steps each; Prony: the 3 s run and the matrix-pencil fit). The
+//! 3 s run is also timed with the matrix kept (`newton = auto`). A 50-point sweep costs about
+//! 50 Floquet points over the cores; its wall time is measured by `mbd stability` itself (see
+//! the closing note of issue 7).
 
 use criterion::{criterion_group, criterion_main, Criterion};
-use mbd::settings::Request;
+use mbd::settings::{NewtonMode, Request};
 use mbd::study::sweep::{self, Method, SweepSpec};
 
 mod common;
 
 fn runs(c: &mut Criterion) {
     let source = common::model_text("windmill.mbd");
-    if let Ok(compiled) = mbd::compile("windmill.mbd", &source, &[], Request::default()) {
-        let mut out = Vec::with_capacity(1 << 22);
-        c.bench_function("windmill: 3 s run, 6000 steps", |b| {
-            b.iter(|| {
-                out.clear();
-                mbd::run(&compiled, &mut out).is_ok()
-            })
-        });
+    for (label, newton) in [("", NewtonMode::Full), (", newton auto", NewtonMode::Auto)] {
+        let request = Request {
+            newton: Some(newton),
+            ..Request::default()
+        };
+        if let Ok(compiled) = mbd::compile("windmill.mbd", &source, &[], request) {
+            let mut out = Vec::with_capacity(1 << 22);
+            c.bench_function(&format!("windmill: 3 s run, 6000 steps{label}"), |b| {
+                b.iter(|| {
+                    out.clear();
+                    mbd::run(&compiled, &mut out).is_ok()
+                })
+            });
+        }
     }
     for method in [Method::Floquet, Method::Prony] {
         let spec = SweepSpec {
