@@ -24,6 +24,7 @@ const CASES: &[(&str, &[Code])] = &[
     ("unknown_joint_kind", &[Code::E0211]),
     ("unknown_output", &[Code::E0212]),
     ("alpha_out_of_range", &[Code::E0213]),
+    ("unknown_newton_mode", &[Code::E0211]),
     ("joint_to_itself", &[Code::E0301]),
     ("negative_mass", &[Code::E0302]),
     ("zero_length", &[Code::E0303]),
