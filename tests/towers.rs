@@ -245,8 +245,9 @@ fn a_windmill_on_a_light_cantilever_tower_follows_the_windmill_on_the_slider() {
     within(
         "x_hub difference order in the beam mass - 1",
         (order(d2.0, d3.0) - 1.0).abs(),
-        5e-3,
-    ); // measured 1.7e-3
+        1.5e-2,
+    ); // measured 5.0e-3 (1.7e-3 while Newton's SE(3) columns were inexact; those columns at
+       // tolerance 1e-14 measure 4.9e-3)
     within(
         "lag difference order in the beam mass - 1",
         (order(d2.1, d3.1) - 1.0).abs(),

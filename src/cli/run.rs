@@ -113,12 +113,16 @@ pub fn run(a: RunArgs) -> ExitCode {
             report(&r.warnings, &c.sources, format);
             if format == Format::Human {
                 eprintln!(
-                    "{}: {} steps, {} Newton iterations ({} factorizations), {} halvings, max |C| {:.2e} m, {} rows{} in {:.1} ms",
+                    "{}: {} steps, {} Newton iterations ({} factorizations), {} halvings{}, max |C| {:.2e} m, {} rows{} in {:.1} ms",
                     c.model.name,
                     r.stats.steps,
                     r.stats.newton_iterations,
                     r.stats.factorizations,
                     r.stats.halvings,
+                    match r.stats.repredictions {
+                        0 => String::new(),
+                        k => format!(", {k} steps started again from constant velocities"),
+                    },
                     r.stats.max_constraint_violation,
                     r.rows,
                     to_path(output),

@@ -61,6 +61,9 @@ pub struct Assembler {
     indices: Vec<Vec<usize>>,
     local: Vec<f64>,
     local2: Vec<f64>,
+    /// Per element with inertia or damping: the frames among its unknowns, each with the
+    /// local positions of its translation and rotation unknowns.
+    rated: Vec<(usize, Vec<(usize, [usize; 6])>)>,
     pub residual: Residual,
     /// Generalized momenta `P = M(q) V` and transport terms `G` (`dP/dt + G = F^I`).
     pub momentum: Vec<f64>,
@@ -88,6 +91,7 @@ impl Assembler {
             maps.push(m);
         }
         let values = vec![0.0; pattern.nnz()];
+        let rated = Self::rated(sys, &indices);
         Assembler {
             pattern,
             values,
@@ -95,9 +99,86 @@ impl Assembler {
             indices,
             local: vec![0.0; largest * largest],
             local2: vec![0.0; largest * largest],
+            rated,
             residual: Residual::new(n),
             momentum: vec![0.0; n],
             transport: vec![0.0; n],
+        }
+    }
+
+    /// The elements whose tangent depends on the rates of frames (`System::is_frame`), with
+    /// each frame's unknowns in local positions (a frame counts only with all six).
+    fn rated(sys: &System, indices: &[Vec<usize>]) -> Vec<(usize, Vec<(usize, [usize; 6])>)> {
+        let mut frame_at = vec![None; sys.len()];
+        for (k, &r) in sys.rotations.iter().enumerate() {
+            if sys.is_frame(k) {
+                frame_at[r] = Some(k);
+            }
+        }
+        let mut out = Vec::new();
+        for (e, (el, idx)) in sys.elements.iter().zip(indices).enumerate() {
+            if !el.has_rates() {
+                continue;
+            }
+            let local = |g: usize| idx.iter().position(|&i| i == g);
+            let nodes: Vec<(usize, [usize; 6])> = idx
+                .iter()
+                .filter_map(|&i| frame_at[i])
+                .filter_map(|k| {
+                    let (t, r) = (sys.translations[k], sys.rotations[k]);
+                    let at = [t, t + 1, t + 2, r, r + 1, r + 2].map(local);
+                    at.iter()
+                        .all(Option::is_some)
+                        .then(|| (k, at.map(|x| x.unwrap_or(0))))
+                })
+                .collect();
+            if !nodes.is_empty() {
+                out.push((e, nodes));
+            }
+        }
+        out
+    }
+
+    /// Adds `M E_a[k] + C E_v[k]` over the columns of every frame `k`, where `M` and
+    /// `C` are the elements' derivatives with respect to the accelerations and velocities
+    /// (inertial components; `C` with the damping weighted by `force_weight`), and `E_a[k]`,
+    /// `E_v[k]` (row-major 6x6 over the node's translation then rotation unknowns) say how the
+    /// node's rates move beyond the scalar coefficients of [`Assembler::tangent`].
+    pub fn add_rate_columns(
+        &mut self,
+        sys: &System,
+        st: &State,
+        aug: Augment,
+        force_weight: f64,
+        maps: &[([f64; 36], [f64; 36])],
+    ) {
+        let rates = |mass: f64, velocity: f64| TangentCoeffs {
+            mass,
+            velocity,
+            position: 0.0,
+            force_weight,
+        };
+        for (e, nodes) in &self.rated {
+            let (el, map) = (&sys.elements[*e], &self.maps[*e]);
+            let nl2 = map.len();
+            let nl = self.indices[*e].len();
+            el.tangent(st, aug, rates(1.0, 0.0), &mut self.local[..nl2]);
+            el.tangent(st, aug, rates(0.0, 1.0), &mut self.local2[..nl2]);
+            for (k, at) in nodes {
+                let (ev, ea) = &maps[*k];
+                for i in 0..nl {
+                    let (m, c) = (&self.local[i * nl..], &self.local2[i * nl..]);
+                    for b in 0..6 {
+                        let mut sum = 0.0;
+                        for (a, &la) in at.iter().enumerate() {
+                            sum += m[la] * ea[a * 6 + b] + c[la] * ev[a * 6 + b];
+                        }
+                        if let Some(x) = self.values.get_mut(map[i * nl + at[b]]) {
+                            *x += sum;
+                        }
+                    }
+                }
+            }
         }
     }
 

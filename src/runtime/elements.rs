@@ -33,6 +33,15 @@ impl Element {
         }
     }
 
+    /// Whether the tangent depends on the rates (inertia, damping).
+    pub fn has_rates(&self) -> bool {
+        match self {
+            Element::PointMass(_) | Element::RigidBody(_) | Element::Beam(_) => true,
+            Element::Spring(s) => s.damping != 0.0,
+            Element::Joint(_) | Element::Load(_) => false,
+        }
+    }
+
     pub fn translational_mass(&self) -> Option<f64> {
         match self {
             Element::PointMass(p) => Some(p.mass),

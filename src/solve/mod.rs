@@ -64,6 +64,9 @@ pub struct RunStats {
     pub steps: usize,
     pub newton_iterations: usize,
     pub halvings: usize,
+    /// Steps started again from constant velocities (Newton failed from the unchanged
+    /// acceleration, or found another root of the step's equations).
+    pub repredictions: usize,
     /// Numeric factorizations of the iteration matrix (one per Newton iteration with
     /// `newton = full`; fewer when the matrix is kept).
     pub factorizations: usize,

@@ -19,6 +19,8 @@ mod se3;
 mod start;
 mod start_matrix;
 mod statics;
+#[cfg(test)]
+mod tests;
 
 pub use linearize::Linearization;
 
@@ -34,6 +36,20 @@ use start_matrix::StartMetric;
 
 /// Largest rotation of a node in one Newton correction (rad).
 const MAX_TURN: f64 = 0.5;
+
+/// The farthest a node may turn from the step's prediction to its solution (rad): beyond it,
+/// Newton has left the prediction's neighbourhood for another root of the step's equations
+/// (on the paper's two-bar at 0.05 s such roots turn a bar by 1.4 to 12 rad in one step).
+const TRUST: f64 = 1.0;
+
+/// Where a step's Newton iteration starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Predictor {
+    /// The acceleration unchanged (statics: the last load step's equilibrium).
+    Acceleration,
+    /// The velocity unchanged, for a step too long for the accelerations' changes.
+    Velocity,
+}
 
 /// How the rotation unknowns are held.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,8 +97,10 @@ pub struct Integrator<'s> {
     /// kept (`newton = modified | auto`); `None` when it must be made anew.
     lu: SparseLu,
     kept: Option<f64>,
-    /// The iterate (and FET's mid-configuration) before a correction by a kept matrix.
+    /// The iterate before the last correction (FET's mid-configuration, the step's
+    /// increments), to take back a kept matrix's correction.
     saved: (State, State),
+    saved_steps: (Vec<f64>, Vec<[f64; 6]>),
     /// The multipliers of the step before the current one, and the size of the last two steps
     /// when they were equal.
     lambda_prev: (Vec<f64>, Option<f64>),
@@ -95,16 +113,21 @@ pub struct Integrator<'s> {
     /// rotation unknowns of each node with `R` (incremental, SE(3)).
     transform: Transform,
     blocks: Vec<usize>,
-    /// Block matrices for the rows (`H(c)` or `R`) and for the columns (`H(c)`, or
-    /// `R J_r^-1(increment)`, which accounts for the increment's dependence on the correction).
+    /// Block matrices for the rows and the columns: `H(c)` or `R`.
     mats: Vec<M3>,
-    cols: Vec<M3>,
     /// Unknowns moved by the SE(3) node updates instead of Newmark on coordinates.
     in_frame: Vec<bool>,
     /// The step's increment so far: of each coordinate (not in a frame), and of each node's
     /// frame (body-frame `(u, theta)`; rotation only for nodes that are not frames).
     step_q: Vec<f64>,
     step_frames: Vec<[f64; 6]>,
+    /// Per rotating node, how its rates move with a correction beyond the scalar coefficients
+    /// ([`se3::rate_maps`]).
+    rate_maps: Vec<([f64; 36], [f64; 36])>,
+    /// Each node's frame increment at constant velocities: the centre of [`TRUST`].
+    predicted: Vec<[f64; 6]>,
+    /// Whether the step's last Newton iteration headed for another root ([`TRUST`]).
+    far: bool,
     /// The converged state at the current time.
     cur: State,
     /// The iterate of the step being solved.
@@ -183,18 +206,21 @@ impl<'s> Integrator<'s> {
             lu,
             kept: None,
             saved: (sys.initial.clone(), sys.initial.clone()),
+            saved_steps: (vec![0.0; n], vec![[0.0; 6]; nodes]),
             reuse: Reuse::new(set.newton, set.method),
             lambda_prev: (vec![0.0; n], None),
             last_h: None,
             mass_lu: None,
             transform,
             mats: vec![M3::identity(); blocks.len()],
-            cols: vec![M3::identity(); blocks.len()],
             blocks,
             block_node,
             in_frame,
             step_q: vec![0.0; n],
             step_frames: vec![[0.0; 6]; nodes],
+            rate_maps: vec![([0.0; 36], [0.0; 36]); nodes],
+            predicted: vec![[0.0; 6]; nodes],
+            far: false,
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
             rhs: vec![0.0; n],
@@ -402,6 +428,49 @@ impl<'s> Integrator<'s> {
         Ok(())
     }
 
+    /// Keeps the iterate before a correction.
+    fn save(&mut self) {
+        self.saved.0.assign(&self.trial);
+        self.saved.1.assign(&self.mid);
+        self.saved_steps.0.copy_from_slice(&self.step_q);
+        self.saved_steps.1.copy_from_slice(&self.step_frames);
+    }
+
+    /// An iterate whose nodes turned farther than [`TRUST`] from the prediction is heading
+    /// for another root of the step's equations than the motion's.
+    fn trust(&mut self) -> Result<(), StepFailure> {
+        if self.layout != Layout::Increments {
+            return Ok(());
+        }
+        let turn =
+            |a: &[f64; 6], b: &[f64; 6]| V3::new(a[3] - b[3], a[4] - b[4], a[5] - b[5]).norm();
+        let (k, far) = self
+            .step_frames
+            .iter()
+            .zip(&self.predicted)
+            .map(|(a, b)| turn(a, b))
+            .enumerate()
+            .filter(|&(k, _)| self.sys.is_frame(k))
+            .fold((0, 0.0f64), |m, (k, t)| if t > m.1 { (k, t) } else { m });
+        if far <= TRUST {
+            return Ok(());
+        }
+        self.far = true;
+        Err(StepFailure {
+            kind: FailureKind::NewtonDiverged,
+            entity: Some(self.sys.owners[self.sys.rotations[k]]),
+            detail: format!("Newton's iterate turned {far:.2} rad from the step's prediction (more than {TRUST} rad), towards another root of the step's equations"),
+        })
+    }
+
+    /// Returns to the iterate before the last correction.
+    fn restore(&mut self) {
+        self.trial.assign(&self.saved.0);
+        self.mid.assign(&self.saved.1);
+        self.step_q.copy_from_slice(&self.saved_steps.0);
+        self.step_frames.copy_from_slice(&self.saved_steps.1);
+    }
+
     /// The step's end: the counts, and the converged iterate made current.
     fn converge(&mut self, it: usize, cnorm: f64, aug: Augment, h: f64) -> Result<(), StepFailure> {
         self.stats.newton_iterations += it;
@@ -417,9 +486,24 @@ impl<'s> Integrator<'s> {
         }
     }
 
-    /// One step of size `h` from `cur` by the method's Newton iteration; on success `cur`
-    /// holds the new state.
+    /// One step of size `h` from `cur`; on success `cur` holds the new state. The Newmark
+    /// family predicts the acceleration unchanged; when Newton heads from there for another
+    /// root of the step's equations ([`TRUST`]), the step starts again from constant
+    /// velocities before it is halved. (Always starting again from constant velocities saves
+    /// the paper's rigid two-bar its 3 halvings but costs its beam model 52 more: a stiff
+    /// element's velocities carry its vibration.)
     fn attempt(&mut self, h: f64) -> Result<(), StepFailure> {
+        self.far = false;
+        let first = self.newton(h, Predictor::Acceleration);
+        if first.is_ok() || !self.far {
+            return first;
+        }
+        self.stats.repredictions += 1;
+        self.newton(h, Predictor::Velocity)
+    }
+
+    /// The Newton iteration of one step from the predictor.
+    fn newton(&mut self, h: f64, predictor: Predictor) -> Result<(), StepFailure> {
         let aug = self.scaling(h);
         let rescale = self.aug.s / aug.s;
         let fet = self.method == Method::Fet;
@@ -428,7 +512,7 @@ impl<'s> Integrator<'s> {
         if fet {
             self.fet_predict(h, rescale);
         } else {
-            self.newmark_predict(h, rescale, keep_rate > 0.0);
+            self.newmark_predict(h, rescale, keep_rate > 0.0, predictor);
         }
         let mut newton = Newton::new(&self.set, self.sys);
         let max = self.set.max_iterations;
@@ -438,18 +522,18 @@ impl<'s> Integrator<'s> {
         for it in 0..=max {
             let mut r = self.residual(fet, h, aug, newton.floor)?;
             let mut total = r.force + aug.s * r.constraint;
+            if newton.converged(r.force, r.scale, r.constraint) {
+                self.reuse
+                    .end(it, self.stats.factorizations - factorizations);
+                return self.converge(it, r.constraint, aug, h);
+            }
             // A kept matrix's correction that made the residual grow is taken back, and a new
             // matrix made at the iterate before it.
             let rejected = after_kept && total > last_total;
             if rejected {
-                self.trial.assign(&self.saved.0);
-                self.mid.assign(&self.saved.1);
+                self.restore();
                 r = self.residual(fet, h, aug, newton.floor)?;
                 total = r.force + aug.s * r.constraint;
-            } else if newton.converged(r.force, r.scale, r.constraint) {
-                self.reuse
-                    .end(it, self.stats.factorizations - factorizations);
-                return self.converge(it, r.constraint, aug, h);
             }
             let what = if fet { " of the time element" } else { "" };
             let norms = (r.force, r.scale, r.constraint);
@@ -465,8 +549,6 @@ impl<'s> Integrator<'s> {
                 self.refactor(h, aug, fet)?;
                 self.lu.solve(&mut self.rhs)
             } else {
-                self.saved.0.assign(&self.trial);
-                self.saved.1.assign(&self.mid);
                 // Newton's next iteration refines a kept matrix's solution.
                 self.lu.solve_unrefined(&mut self.rhs)
             }
@@ -474,12 +556,14 @@ impl<'s> Integrator<'s> {
             if self.layout != Layout::Conformal {
                 self.limit_turn();
             }
+            self.save();
             let dmax = if fet {
                 self.fet_correct()
             } else {
                 self.newmark_correct(h)
             };
             newton.record(dmax, fresh);
+            self.trust()?;
             (after_kept, last_total) = (!fresh, total);
         }
         Err(StepFailure {

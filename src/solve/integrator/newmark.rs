@@ -17,7 +17,7 @@
 //! unknowns hold `c`, `c-dot`, `c-ddot` like any coordinate ([`super::rotations`]).
 
 use super::{rotations, se3};
-use super::{Integrator, Layout, Norms, StepFailure};
+use super::{Integrator, Layout, Norms, Predictor, StepFailure};
 use crate::runtime::rotation::{self as rot};
 use crate::runtime::{Augment, TangentCoeffs, UnknownKind};
 use crate::settings::{Method, Settings};
@@ -76,7 +76,13 @@ impl Scheme {
 impl Integrator<'_> {
     /// Predictor: the acceleration `a_{n+1} = a_n` (statics: the previous load step's
     /// equilibrium); the multipliers carried over at the new scaling.
-    pub(super) fn newmark_predict(&mut self, h: f64, rescale: f64, extrapolate: bool) {
+    pub(super) fn newmark_predict(
+        &mut self,
+        h: f64,
+        rescale: f64,
+        extrapolate: bool,
+        predictor: Predictor,
+    ) {
         let sc = self.sc;
         // A kept matrix corrects the multipliers slowly (joint forces in inertial components
         // turn with the bodies, by about `omega h` a step): they start from their linear
@@ -90,6 +96,8 @@ impl Integrator<'_> {
             let alg = (a - sc.am * alg0) / (1.0 - sc.am);
             if hold {
                 0.0
+            } else if predictor == Predictor::Velocity {
+                h * v
             } else {
                 h * v + h * h * ((0.5 - sc.beta) * alg0 + sc.beta * alg)
             }
@@ -121,6 +129,10 @@ impl Integrator<'_> {
                 };
                 se3::displace(self.sys, cur, tr, k, &d);
             }
+        }
+        // The trust region's centre: the step at constant velocities.
+        for (p, f) in self.predicted.iter_mut().zip(&self.cur.frames) {
+            *p = f.v.map(|v| h * v);
         }
         self.newmark(h);
     }
@@ -188,11 +200,29 @@ impl Integrator<'_> {
             }
         };
         self.asm.tangent(self.sys, &self.trial, aug, coeffs);
+        // SE(3) frames: the Newmark relations act on body-frame twists, so the inertial
+        // terms' columns take how those move with a correction (`se3::rate_maps`).
+        if self.layout == Layout::Increments && self.method != Method::Static {
+            for k in 0..self.sys.rotations.len() {
+                if self.sys.is_frame(k) {
+                    self.rate_maps[k] = se3::rate_maps(
+                        self.sys,
+                        &self.trial,
+                        k,
+                        &self.step_frames[k],
+                        coeffs.velocity,
+                        coeffs.mass,
+                    );
+                }
+            }
+            self.asm
+                .add_rate_columns(self.sys, &self.trial, aug, 1.0, &self.rate_maps);
+        }
         self.transform.apply(
             &self.asm.pattern,
             &mut self.asm.values,
             &self.mats,
-            &self.cols,
+            &self.mats,
         );
     }
 
@@ -273,33 +303,17 @@ impl Integrator<'_> {
         let nodes = self.sys.rotations.len();
         if self.layout == Layout::Conformal {
             rotations::tangents(self.sys, &self.trial, &mut self.mats);
-            self.cols.copy_from_slice(&self.mats);
         } else {
             // Rotation blocks come last, one per node in order.
             let first = self.blocks.len() - nodes;
             for k in 0..nodes {
-                let r = self.trial.rot[k].matrix();
-                self.mats[first + k] = r;
-                let th = rot::log(&(self.cur.rot[k].matrix().transpose() * r));
-                // The correction moves R by exactly R d, and the step increment by
-                // J_r^-1(th) d, on which the Newmark rates depend: R J_r^-1 is exact for the
-                // inertial terms, R for the configuration terms. Beam nodes take R (their
-                // elastic stiffness dominates, and would leak through an O(th) error from stiff
-                // to soft directions), frames R J_r^-1 (their tangent is all inertia; the
-                // constraint columns then carry an O(th) error and Newton converges linearly at
-                // a rate near omega h / 2: the exact SE(3) columns, on branch
-                // `exact-se3-newton`, halve the iterations but lose Newton in the violent
-                // motion of P3 after 15 s at dt = 0.05).
-                self.cols[first + k] = if self.sys.is_frame(k) && self.method != Method::Static {
-                    r * rot::left_jacobian_inverse(&-th)
-                } else {
-                    r
-                };
+                // A correction moves the frame by exactly `R d`: `R` for every column, the
+                // Newmark rates' dependence on the increment added by `se3::rate_maps`.
+                self.mats[first + k] = self.trial.rot[k].matrix();
             }
             for b in 0..first {
                 let k = self.block_node[b];
                 self.mats[b] = self.mats[first + k];
-                self.cols[b] = self.cols[first + k];
             }
         }
     }

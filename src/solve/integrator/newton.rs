@@ -60,7 +60,13 @@ impl Newton {
             self.last_increment <= self.atol && self.last_increment > 0.1 * self.previous_increment;
         let settled =
             rnorm <= self.rtol * scale || self.last_increment <= 1e-3 * self.atol || stalled;
-        small && settled
+        // The contraction measured over the last two corrections bounds what is left: a
+        // correction above the tolerance may end the step when its tail is below TAIL of it.
+        let theta = self.last_increment / self.previous_increment;
+        let contracted = theta < 1.0
+            && self.last_increment * theta / (1.0 - theta) <= TAIL * self.atol
+            && rnorm <= self.rtol * scale;
+        (small && settled) || (contracted && cnorm <= self.ltol)
     }
 
     /// The contraction of the last correction: its increment over the one before (0 before

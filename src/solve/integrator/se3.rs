@@ -11,7 +11,7 @@
 //! Nodes that are not frames (`System::is_frame`, beam nodes) keep only the rotational half:
 //! `R <- R exp(dtheta*)` with Newmark on `R^T omega`, their translations being coordinates.
 
-use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, M3, V3};
+use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, tilde, M3, V3};
 use crate::runtime::{State, System};
 
 fn x_of(st: &State, t: usize) -> V3 {
@@ -108,11 +108,145 @@ fn compose_rotations(a: &V3, b: &V3) -> V3 {
 /// turns), whose round-off `1/(beta h^2)` would amplify into the accelerations. Nodes that are
 /// not frames compose their rotation only.
 pub fn compose(sys: &System, k: usize, d0: &[f64; 6], d: &[f64; 6]) -> [f64; 6] {
-    let ((u0, t0), (u, t)) = (split(d0), split(d));
-    let th = compose_rotations(&t0, &t);
     if !sys.is_frame(k) {
+        let th = compose_rotations(&split(d0).1, &split(d).1);
         return join(&V3::zeros(), &th);
     }
+    compose_frames(d0, d)
+}
+
+/// `log(exp(d0) exp(d))` in SE(3), twists as `(u, theta)`.
+fn compose_frames(d0: &[f64; 6], d: &[f64; 6]) -> [f64; 6] {
+    let ((u0, t0), (u, t)) = (split(d0), split(d));
+    let th = compose_rotations(&t0, &t);
     let p = left_jacobian(&t0) * u0 + exp(&t0) * (left_jacobian(&t) * u);
     join(&(left_jacobian_inverse(&th) * p), &th)
+}
+
+/// The translation-rotation block `Q(u, theta)` of SE(3)'s left Jacobian
+/// `[[J_l(theta), Q], [0, J_l(theta)]]` (Barfoot, *State Estimation for Robotics*, 2017,
+/// eq. 7.86), with its series below 1e-2 rad.
+fn coupling(u: &V3, th: &V3) -> M3 {
+    let t = th.norm();
+    let (ut, tt) = (tilde(u), tilde(th));
+    let (a, b, c) = if t < 1e-2 {
+        let t2 = t * t;
+        (
+            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
+            1.0 / 24.0 - t2 / 720.0 + t2 * t2 / 40320.0,
+            1.0 / 120.0 - t2 / 2520.0 + t2 * t2 / 120960.0,
+        )
+    } else {
+        let (s, co) = t.sin_cos();
+        (
+            (t - s) / t.powi(3),
+            (t * t + 2.0 * co - 2.0) / (2.0 * t.powi(4)),
+            (2.0 * t - 3.0 * s + t * co) / (2.0 * t.powi(5)),
+        )
+    };
+    let (tu, ttu) = (tt * ut, tt * tt * ut);
+    let tut = tu * tt;
+    ut * 0.5
+        + (tu + ut * tt + tut) * a
+        + (ttu + ut * tt * tt - tut * 3.0) * b
+        + (tut * tt + tt * tut) * c
+}
+
+/// `d log(exp(d0) exp(d)) / d d` at `d = 0`, SE(3)'s inverse right Jacobian at `d0`, as its
+/// diagonal block `J_r^-1(theta)` and its translation-rotation block.
+pub fn right_jacobian_inverse(d0: &[f64; 6]) -> (M3, M3) {
+    let (u, th) = split(d0);
+    let ja = left_jacobian_inverse(&-th);
+    (ja, -ja * coupling(&-u, &-th) * ja)
+}
+
+/// How node `k`'s inertial rates move with a body-frame correction `d`, beyond `velocity` and
+/// `mass` times the position columns `R`: 6x6 maps `(E_v, E_a)`, row-major over (translation,
+/// rotation), acting on the inertial position columns (so that `M E_a + C E_v` times `T = R`
+/// is what the Newmark relations on body-frame twists add to `(mass M + velocity C) T`).
+/// With `J = [[A, B], [0, A]]` the increment's inverse right Jacobian, `^` the rotation by
+/// `R` (`A^ = R A R^T`):
+/// `E_v = c_v [[A^ - I, B^], [0, A^ - I]] - [[0, x-dot~], [0, w~]]`,
+/// `E_a = c_a [[A^ - I, B^], [0, A^ - I]] + c_v [[w~ A^, w~ B^ - x-dot~ A^], [0, 0]]
+/// - [[0, x-ddot~], [0, w-dot~]]`. Nodes that are not frames keep the rotation blocks alone.
+pub fn rate_maps(
+    sys: &System,
+    st: &State,
+    k: usize,
+    d0: &[f64; 6],
+    cv: f64,
+    ca: f64,
+) -> ([f64; 36], [f64; 36]) {
+    let (t, r) = (sys.translations[k], sys.rotations[k]);
+    let g = |x: &[f64], i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
+    let rm = st.rot[k].matrix();
+    let (w, dw) = (g(&st.v, r), g(&st.a, r));
+    let (ja, jb) = right_jacobian_inverse(d0);
+    let a = rm * ja * rm.transpose() - M3::identity();
+    let mut ev = [0.0; 36];
+    let mut ea = [0.0; 36];
+    let put = |m: &mut [f64; 36], r0: usize, c0: usize, b: &M3| {
+        for i in 0..3 {
+            for j in 0..3 {
+                m[(r0 + i) * 6 + c0 + j] += b[(i, j)];
+            }
+        }
+    };
+    put(&mut ev, 3, 3, &(a * cv - tilde(&w)));
+    put(&mut ea, 3, 3, &(a * ca - tilde(&dw)));
+    if sys.is_frame(k) {
+        let (xd, xdd) = (g(&st.v, t), g(&st.a, t));
+        let b = rm * jb * rm.transpose();
+        let ah = a + M3::identity();
+        put(&mut ev, 0, 0, &(a * cv));
+        put(&mut ev, 0, 3, &(b * cv - tilde(&xd)));
+        put(&mut ea, 0, 0, &(a * ca + tilde(&w) * ah * cv));
+        put(
+            &mut ea,
+            0,
+            3,
+            &(b * ca + (tilde(&w) * b - tilde(&xd) * ah) * cv - tilde(&xdd)),
+        );
+    }
+    (ev, ea)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The inverse right Jacobian is the derivative of the composition (central differences,
+    /// agreement 1e-8 relative; measured 3e-10), at large and at small rotations.
+    #[test]
+    fn right_jacobian_inverse_is_the_derivative_of_composition() {
+        for d0 in [
+            [0.3, -0.7, 1.1, 0.9, -0.4, 1.3],
+            [0.3, -0.7, 1.1, 2e-3, -1e-3, 4e-3],
+            [-1.2, 0.5, 0.2, 1e-7, 3e-8, -2e-7],
+        ] {
+            let (ja, jb) = right_jacobian_inverse(&d0);
+            let e = 1e-6;
+            for j in 0..6 {
+                let mut dp = [0.0; 6];
+                dp[j] = e;
+                let (p, m) = (
+                    compose_frames(&d0, &dp),
+                    compose_frames(&d0, &dp.map(|x| -x)),
+                );
+                for i in 0..6 {
+                    let fd = (p[i] - m[i]) / (2.0 * e);
+                    let exact = match (i < 3, j < 3) {
+                        (true, true) => ja[(i, j)],
+                        (true, false) => jb[(i, j - 3)],
+                        (false, true) => 0.0,
+                        (false, false) => ja[(i - 3, j - 3)],
+                    };
+                    assert!(
+                        (fd - exact).abs() < 1e-8,
+                        "{d0:?} ({i}, {j}): {fd} vs {exact}"
+                    );
+                }
+            }
+        }
+    }
 }
