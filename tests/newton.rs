@@ -173,21 +173,31 @@ fn two_bar_stats(sets: &[String], dt: f64, until: f64) -> RunStats {
 /// twists move with a correction, so Newton is quadratic on rigid bodies in large motion.
 #[test]
 fn exact_frame_columns_take_two_iterations_a_step_in_smooth_motion() {
-    // theta2_0 = 0 at dt 1 ms: measured 2.02 iterations a step (3.08 with the columns before).
+    // theta2_0 = 0 at dt 1 ms: measured 1.73 iterations a step (3.08 with the columns before)
+    // and 1.000 factorizations: a correction of at most 1e-6 is followed by one with the same
+    // matrix.
     let smooth = two_bar_stats(&["theta2_0=0".into()], 1e-3, 10.0);
     let per_step = smooth.newton_iterations as f64 / smooth.steps as f64;
+    let factored = smooth.factorizations as f64 / smooth.steps as f64;
+    eprintln!("two-bar at 1 ms: {per_step:.3} iterations, {factored:.3} factorizations a step");
     within(
         "iterations a step, two-bar theta2_0 = 0, dt 1 ms",
         per_step,
-        2.1,
+        1.8,
+    );
+    within(
+        "factorizations a step, two-bar theta2_0 = 0, dt 1 ms",
+        factored,
+        1.02,
     );
     // P3 at its step, 0.05 s, 50 s: measured 4.32 iterations a step (those of the attempts
-    // that converged), 4.37 factorizations a step, 3 halvings; the columns before took 10.74
+    // that converged), 3.97 factorizations a step, 3 halvings; the columns before took 10.74
     // iterations, 10.83 factorizations and 8 halvings.
     let p3 = two_bar_stats(&[], 0.05, 50.0);
     let per_step = p3.newton_iterations as f64 / p3.steps as f64;
     let factored = p3.factorizations as f64 / p3.steps as f64;
+    eprintln!("P3: {per_step:.3} iterations, {factored:.3} factorizations a step");
     within("iterations a step, P3 at 0.05 s", per_step, 4.6);
-    within("factorizations a step, P3 at 0.05 s", factored, 4.7);
+    within("factorizations a step, P3 at 0.05 s", factored, 4.3);
     within("halvings, P3 at 0.05 s", p3.halvings as f64, 4.0);
 }
