@@ -64,8 +64,8 @@ pub struct RunStats {
     pub steps: usize,
     pub newton_iterations: usize,
     pub halvings: usize,
-    /// Steps started again from constant velocities (Newton failed from the unchanged
-    /// acceleration, or found another root of the step's equations).
+    /// Steps started again from constant velocities (Newton headed for another root of the
+    /// step's equations from the unchanged acceleration).
     pub repredictions: usize,
     /// Numeric factorizations of the iteration matrix (one per Newton iteration with
     /// `newton = full`; fewer when the matrix is kept).
