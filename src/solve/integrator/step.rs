@@ -143,7 +143,9 @@ impl Integrator<'_> {
             if self.layout != Layout::Conformal {
                 self.limit_turn();
             }
-            self.save();
+            if !fresh {
+                self.save();
+            }
             let dmax = if fet {
                 self.fet_correct()
             } else {
