@@ -17,9 +17,10 @@ pub(super) enum Predictor {
     Velocity,
 }
 
-/// The farthest a node may turn from the step's prediction to its solution (rad): beyond it,
-/// Newton has left the prediction's neighbourhood for another root of the step's equations
-/// (on the paper's two-bar at 0.05 s such roots turn a bar by 1.4 to 12 rad in one step).
+/// The farthest a frame's iterate may turn from the step at constant velocities (rad): beyond
+/// it, Newton has left the motion's neighbourhood for another root of the step's equations (on
+/// the paper's two-bar at 0.05 s such roots turn a bar by 1.4 to 12 rad in one step, where the
+/// motion turns it 0.4 rad).
 const TRUST: f64 = 1.0;
 
 impl Integrator<'_> {
