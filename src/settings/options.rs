@@ -90,15 +90,16 @@ impl Start {
 /// A kept matrix contracts linearly, so its step ends where the residual and the contraction's
 /// tail are below the tolerances, not at round-off: joint loads to the residual tolerance
 /// (about 1e-8 of the largest force) where a new matrix gets them to 1e-13, the constraint to
-/// the increment tolerance where a new matrix meets it to round-off. On the windmill its
-/// solution is ten times closer to the discrete equations' (6.9e-6 of the hub motion at 3 s
-/// against 6.8e-5, both against a run at tolerance 1e-12), since a new matrix's single
-/// iteration a step stops at the tolerance too; but the accuracy tests' bounds were measured
-/// with new matrices, and 16 of them fail with a kept one: `full` stays the default.
+/// the increment tolerance where a new matrix meets it to round-off. On the windmill a new
+/// matrix, exact for rigid frames, lands 9.5e-9 of the hub motion from the discrete equations'
+/// solution at 3 s and a kept one 1.5e-6 (both against a run at tolerance 1e-12): `full`
+/// stays the default.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum NewtonMode {
-    /// A new iteration matrix at every iteration (the default).
+    /// A new iteration matrix at every iteration (the default); in models without beams, a
+    /// correction of at most 1e-6 is followed by one with the step's matrix, then as good as
+    /// new.
     #[default]
     Full,
     /// The factored matrix kept across iterations and steps while each correction it makes
