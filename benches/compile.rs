@@ -1,5 +1,5 @@
 //! Benchmarks of the compiler on the validation models: parse, elaborate the stdlib components,
-//! build, topology checks (dense ranks) and unknown numbering.
+//! build, topology checks (ranks block by block) and unknown numbering.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use mbd::settings::Request;

@@ -50,6 +50,24 @@ impl Span {
 pub struct SourceFile {
     pub name: String,
     pub text: String,
+    /// The byte offset of each line's start, built once (line and column lookups, the
+    /// windows diagnostics render, in time independent of where in the file they are).
+    line_starts: Vec<usize>,
+}
+
+impl SourceFile {
+    /// The 0-based line holding byte `offset`.
+    pub fn line_of(&self, offset: usize) -> usize {
+        self.line_starts
+            .partition_point(|&s| s <= offset)
+            .saturating_sub(1)
+    }
+
+    /// The byte range of lines `from..to` (0-based, clamped), their line ends included.
+    pub fn lines(&self, from: usize, to: usize) -> std::ops::Range<usize> {
+        let at = |l: usize| self.line_starts.get(l).copied().unwrap_or(self.text.len());
+        at(from)..at(to)
+    }
 }
 
 /// Every text a compilation has read. Diagnostics render against it.
@@ -64,9 +82,14 @@ impl SourceMap {
     }
 
     pub fn add(&mut self, name: impl Into<String>, text: impl Into<String>) -> SourceId {
+        let text: String = text.into();
+        let line_starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
         self.files.push(SourceFile {
             name: name.into(),
-            text: text.into(),
+            text,
+            line_starts,
         });
         SourceId((self.files.len() - 1) as u32)
     }
@@ -87,16 +110,40 @@ impl SourceMap {
 
     /// 1-based line and column (in characters) of a byte offset.
     pub fn line_col(&self, source: SourceId, offset: u32) -> (usize, usize) {
-        let text = self.text(source);
-        let offset = (offset as usize).min(text.len());
-        let before = text.get(..offset).unwrap_or("");
-        let line = before.matches('\n').count() + 1;
-        let col = before
-            .rsplit('\n')
-            .next()
-            .map(|l| l.chars().count())
-            .unwrap_or(0)
+        let Some(file) = self.get(source) else {
+            return (1, 1);
+        };
+        let offset = (offset as usize).min(file.text.len());
+        let line = file.line_of(offset);
+        let start = file.line_starts[line];
+        let col = file
+            .text
+            .get(start..offset)
+            .map_or(0, |l| l.chars().count())
             + 1;
-        (line, col)
+        (line + 1, col)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn lines_and_columns_come_from_the_index() {
+        let mut m = SourceMap::new();
+        let id = m.add("f", "ab\nçd\n\nlast");
+        let f = m.get(id).expect("added");
+        assert_eq!(m.line_col(id, 0), (1, 1));
+        assert_eq!(m.line_col(id, 2), (1, 3));
+        assert_eq!(m.line_col(id, 3), (2, 1));
+        // Columns count characters: `ç` is two bytes.
+        assert_eq!(m.line_col(id, 5), (2, 2));
+        assert_eq!(m.line_col(id, 7), (3, 1));
+        assert_eq!(m.line_col(id, 8), (4, 1));
+        assert_eq!(m.line_col(id, 100), (4, 5));
+        assert_eq!(f.line_of(8), 3);
+        assert_eq!(&f.text[f.lines(1, 3)], "çd\n\n");
+        assert_eq!(&f.text[f.lines(3, 9)], "last");
     }
 }

@@ -25,6 +25,7 @@ mod rigid;
 mod robustness;
 mod rotor;
 mod rotor_stability;
+mod scale;
 mod shapes;
 mod spectral;
 mod study;

@@ -17,7 +17,7 @@ mod swept;
 
 use clap::ValueEnum;
 use loader::FsLoader;
-use mbd::diagnostics::{render_human, render_json, Diagnostic};
+use mbd::diagnostics::{render_human, render_json, summarize, Diagnostic, SHOWN_PER_CODE};
 use mbd::settings::Request;
 use mbd::source::SourceMap;
 use mbd::study::CompileError;
@@ -60,8 +60,12 @@ pub fn report(diags: &[Diagnostic], sources: &SourceMap, format: Format) {
         }
         Format::Human => {
             let color = std::io::stderr().is_terminal() && std::env::var_os("NO_COLOR").is_none();
-            for d in diags {
+            let (shown, more) = summarize(diags, SHOWN_PER_CODE);
+            for d in shown {
                 let _ = write!(err, "{}", render_human(d, sources, color));
+            }
+            for line in more {
+                let _ = writeln!(err, "{line}");
             }
         }
     }

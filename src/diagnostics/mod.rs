@@ -123,6 +123,61 @@ impl Sink {
     }
 }
 
+/// How many diagnostics of one code a person is shown; the rest are counted
+/// ([`summarize`]). JSON output lists every one.
+pub const SHOWN_PER_CODE: usize = 10;
+
+/// The diagnostics to show a person, at most `per_code` of each code in their order, and one
+/// line for each code with more: `... and 19,990 more W0201 warnings`.
+pub fn summarize(diagnostics: &[Diagnostic], per_code: usize) -> (Vec<&Diagnostic>, Vec<String>) {
+    let mut seen: Vec<(Code, Severity, usize)> = Vec::new();
+    let mut shown = Vec::new();
+    for d in diagnostics {
+        let k = match seen.iter().position(|s| s.0 == d.code) {
+            Some(k) => k,
+            None => {
+                seen.push((d.code, d.severity, 0));
+                seen.len() - 1
+            }
+        };
+        seen[k].2 += 1;
+        if seen[k].2 <= per_code {
+            shown.push(d);
+        }
+    }
+    let more = seen
+        .into_iter()
+        .filter(|s| s.2 > per_code)
+        .map(|(code, severity, count)| {
+            let n = count - per_code;
+            let kind = match severity {
+                Severity::Error => "error",
+                Severity::Warning => "warning",
+            };
+            format!(
+                "... and {} more {} {kind}{}",
+                thousands(n),
+                code.as_str(),
+                if n == 1 { "" } else { "s" }
+            )
+        })
+        .collect();
+    (shown, more)
+}
+
+/// `19990` as `19,990`.
+fn thousands(n: usize) -> String {
+    let digits = n.to_string();
+    let mut out = String::new();
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i) % 3 == 0 {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
 /// Reports each mistake once. Diagnostics with the same code and the same labelled spans are
 /// one mistake (a loop body repeats its text; a marker argument used twice repeats its error):
 /// the first is kept, with a label at each loop's header naming the iterations that hit it

@@ -1,15 +1,76 @@
 //! Rendering diagnostics: miette's graphical report for people, JSON for tools.
 
 use super::{Diagnostic, Severity};
-use crate::source::SourceMap;
-use miette::{GraphicalReportHandler, GraphicalTheme, LabeledSpan, NamedSource, SourceSpan};
+use crate::source::{SourceFile, SourceMap};
+use miette::{
+    GraphicalReportHandler, GraphicalTheme, LabeledSpan, MietteError, MietteSpanContents,
+    SourceCode, SourceSpan, SpanContents,
+};
 use std::fmt;
 
 struct Report<'a> {
     diag: &'a Diagnostic,
-    source: Option<NamedSource<String>>,
+    source: Option<Window<'a>>,
     labels: Vec<LabeledSpan>,
     help: Option<String>,
+}
+
+/// The lines of a file around a diagnostic's labels, as miette reads them: each report reads
+/// only its own lines (found from the file's line index), so rendering many diagnostics costs
+/// time linear in their number, not in the file's length times it.
+struct Window<'a> {
+    name: &'a str,
+    text: &'a str,
+    /// The window's first byte and 0-based line in the file.
+    offset: usize,
+    line: usize,
+}
+
+impl Window<'_> {
+    /// Lines this far around the labels: more than the handler's context (one line).
+    const AROUND: usize = 3;
+
+    fn around<'a>(file: &'a SourceFile, spans: impl Iterator<Item = (usize, usize)>) -> Window<'a> {
+        let (lo, hi) = spans.fold((usize::MAX, 0), |(lo, hi), (a, b)| (lo.min(a), hi.max(b)));
+        let lo = lo.min(file.text.len());
+        let from = file.line_of(lo).saturating_sub(Self::AROUND);
+        let to = file.line_of(hi.max(lo).min(file.text.len())) + Self::AROUND + 1;
+        let range = file.lines(from, to);
+        Window {
+            name: &file.name,
+            text: &file.text[range.clone()],
+            offset: range.start,
+            line: from,
+        }
+    }
+}
+
+impl SourceCode for Window<'_> {
+    fn read_span<'a>(
+        &'a self,
+        span: &SourceSpan,
+        before: usize,
+        after: usize,
+    ) -> Result<Box<dyn SpanContents<'a> + 'a>, MietteError> {
+        let start = span
+            .offset()
+            .saturating_sub(self.offset)
+            .min(self.text.len());
+        let local = SourceSpan::new(start.into(), span.len().min(self.text.len() - start));
+        let inner = self.text.read_span(&local, before, after)?;
+        let at = SourceSpan::new(
+            (inner.span().offset() + self.offset).into(),
+            inner.span().len(),
+        );
+        Ok(Box::new(MietteSpanContents::new_named(
+            self.name.to_string(),
+            inner.data(),
+            at,
+            inner.line() + self.line,
+            inner.column(),
+            inner.line_count(),
+        )))
+    }
 }
 
 impl fmt::Debug for Report<'_> {
@@ -95,7 +156,14 @@ pub fn render_human(diag: &Diagnostic, sources: &SourceMap, color: bool) -> Stri
     }
     let report = Report {
         diag,
-        source: source.map(|f| NamedSource::new(f.name.clone(), f.text.clone())),
+        source: source.map(|f| {
+            let spans = diag
+                .labels
+                .iter()
+                .filter(|l| Some(l.span.source) == primary.map(|p| p.source))
+                .map(|l| (l.span.start as usize, l.span.end as usize));
+            Window::around(f, spans)
+        }),
         labels,
         help,
     };

@@ -17,6 +17,7 @@ use crate::model::build::{cross, norm, sub};
 use crate::model::*;
 use nalgebra::{DMatrix, SymmetricEigen};
 
+mod blocks;
 mod massless;
 
 /// Columns of a node in the virtual-motion vector.
@@ -25,12 +26,15 @@ struct Columns {
     rotates: Vec<bool>,
     n: usize,
     nodes: Vec<Node>,
+    /// The index in `nodes` of each beam's first node (bodies come first, one node each).
+    beam_base: Vec<usize>,
 }
 
 fn columns(model: &Model) -> Columns {
     let mut nodes = Vec::new();
     let mut start = Vec::new();
     let mut rotates = Vec::new();
+    let mut beam_base = Vec::new();
     let mut n = 0;
     for (body, b) in model.bodies.iter().enumerate() {
         nodes.push(Node::Body { body });
@@ -40,6 +44,7 @@ fn columns(model: &Model) -> Columns {
         n += if r { 6 } else { 3 };
     }
     for (beam, b) in model.beams.iter().enumerate() {
+        beam_base.push(nodes.len());
         for node in 0..b.nodes.len() {
             nodes.push(Node::BeamNode { beam, node });
             start.push(n);
@@ -52,12 +57,24 @@ fn columns(model: &Model) -> Columns {
         rotates,
         n,
         nodes,
+        beam_base,
     }
 }
 
 impl Columns {
     fn of(&self, node: Node) -> usize {
-        self.nodes.iter().position(|x| *x == node).unwrap_or(0)
+        match node {
+            Node::Body { body } => body,
+            Node::BeamNode { beam, node } => self.beam_base[beam] + node,
+        }
+    }
+
+    fn width(&self, k: usize) -> usize {
+        if self.rotates[k] {
+            6
+        } else {
+            3
+        }
     }
 }
 
@@ -68,38 +85,41 @@ fn node_position(model: &Model, node: Node) -> [f64; 3] {
     }
 }
 
+/// A sparse row: (column, value) pairs, a column possibly repeated (the values add).
+type Row = Vec<(usize, f64)>;
+
 /// Rows of the linearised constraint equations, `dir . (relative translation)` or
 /// `dir . (relative rotation)`, scaled so rotations are measured in lengths of `scale`.
 struct Rows<'a> {
     model: &'a Model,
     cols: &'a Columns,
     scale: f64,
-    rows: Vec<Vec<f64>>,
+    rows: Vec<Row>,
 }
 
 impl Rows<'_> {
     /// Adds `sign * dir . (virtual displacement of the point p attached by a)`.
-    fn translation(&self, row: &mut [f64], a: &Attach, p: [f64; 3], dir: [f64; 3], sign: f64) {
+    fn translation(&self, row: &mut Row, a: &Attach, p: [f64; 3], dir: [f64; 3], sign: f64) {
         let nodes = attach_nodes(self.model, a);
         let w = 1.0 / nodes.len().max(1) as f64;
         for node in nodes {
             let k = self.cols.of(node);
             let s = self.cols.start[k];
             for i in 0..3 {
-                row[s + i] += sign * w * dir[i];
+                row.push((s + i, sign * w * dir[i]));
             }
             if self.cols.rotates[k] {
                 // d . (dtheta x r) = dtheta . (r x d)
                 let r = sub(p, node_position(self.model, node));
                 let c = cross(r, dir);
                 for i in 0..3 {
-                    row[s + 3 + i] += sign * w * c[i] / self.scale;
+                    row.push((s + 3 + i, sign * w * c[i] / self.scale));
                 }
             }
         }
     }
 
-    fn rotation(&self, row: &mut [f64], a: &Attach, dir: [f64; 3], sign: f64) {
+    fn rotation(&self, row: &mut Row, a: &Attach, dir: [f64; 3], sign: f64) {
         let nodes = attach_nodes(self.model, a);
         let w = 1.0 / nodes.len().max(1) as f64;
         for node in nodes {
@@ -107,21 +127,21 @@ impl Rows<'_> {
             if self.cols.rotates[k] {
                 let s = self.cols.start[k];
                 for i in 0..3 {
-                    row[s + 3 + i] += sign * w * dir[i];
+                    row.push((s + 3 + i, sign * w * dir[i]));
                 }
             }
         }
     }
 
     fn lock_translation(&mut self, m: &[Marker; 2], dir: [f64; 3]) {
-        let mut row = vec![0.0; self.cols.n];
+        let mut row = Row::new();
         self.translation(&mut row, &m[1].attach, m[1].position, dir, 1.0);
         self.translation(&mut row, &m[0].attach, m[0].position, dir, -1.0);
         self.rows.push(row);
     }
 
     fn lock_rotation(&mut self, m: &[Marker; 2], dir: [f64; 3]) {
-        let mut row = vec![0.0; self.cols.n];
+        let mut row = Row::new();
         self.rotation(&mut row, &m[1].attach, dir, 1.0);
         self.rotation(&mut row, &m[0].attach, dir, -1.0);
         self.rows.push(row);
@@ -219,10 +239,6 @@ pub fn check(model: &Model, sink: &mut Sink) {
         return;
     }
     connectivity(model, sink);
-    // The dense rank tests cost O(n^3): they run up to a few thousand unknowns.
-    if cols.n > MAX_DENSE {
-        return;
-    }
     let scale = length_scale(model);
     let mut r = Rows {
         model,
@@ -236,9 +252,8 @@ pub fn check(model: &Model, sink: &mut Sink) {
         joint_rows(&mut r, j);
         owner.extend(std::iter::repeat_n(ji, r.rows.len() - before));
     }
-    let m = r.rows.len();
-    if m > 0 {
-        redundancy(model, &r.rows, &owner, cols.n, sink);
+    if !r.rows.is_empty() {
+        redundancy(model, &r, &owner, sink);
     }
     if sink.has_errors() {
         return;
@@ -246,8 +261,84 @@ pub fn check(model: &Model, sink: &mut Sink) {
     massless::check(model, &mut r, sink);
 }
 
-/// Largest number of virtual-motion columns the dense rank checks handle.
-const MAX_DENSE: usize = 3000;
+/// The vertex of the ground in the joint graph, after every node's.
+fn vertices(model: &Model, cols: &Columns, j: &Joint) -> Vec<usize> {
+    let mut v: Vec<usize> = j
+        .markers
+        .iter()
+        .flat_map(|m| match m.attach {
+            Attach::Ground { .. } => vec![cols.nodes.len()],
+            _ => attach_nodes(model, &m.attach)
+                .into_iter()
+                .map(|n| cols.of(n))
+                .collect(),
+        })
+        .collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// The joints that may take part in a constraint dependency, in blocks with disjoint columns
+/// (`blocks.rs`): every joint but the bridges between two vertices.
+fn loop_blocks(model: &Model, cols: &Columns) -> Vec<Vec<usize>> {
+    let nv = cols.nodes.len() + 1;
+    let verts: Vec<Vec<usize>> = model
+        .joints
+        .iter()
+        .map(|j| vertices(model, cols, j))
+        .collect();
+    let (mut edges, mut edge_of) = (Vec::new(), vec![usize::MAX; verts.len()]);
+    for (j, v) in verts.iter().enumerate() {
+        if v.len() == 2 {
+            edge_of[j] = edges.len();
+        }
+        // A joint on more than two vertices (a point between beam nodes) connects them all.
+        edges.extend(v.windows(2).map(|w| (w[0], w[1])));
+    }
+    let bridge = blocks::bridges(nv, &edges);
+    let mut sets = blocks::UnionFind::new(nv);
+    let looped: Vec<usize> = (0..verts.len())
+        .filter(|&j| edge_of[j] == usize::MAX || !bridge[edge_of[j]])
+        .collect();
+    for &j in &looped {
+        for w in verts[j].windows(2) {
+            sets.union(w[0], w[1]);
+        }
+    }
+    let mut by_root: std::collections::BTreeMap<usize, Vec<usize>> = Default::default();
+    let mut order = Vec::new();
+    for &j in &looped {
+        let root = sets.find(verts[j][0]);
+        let block = by_root.entry(root).or_default();
+        if block.is_empty() {
+            order.push(root);
+        }
+        block.push(j);
+    }
+    order
+        .into_iter()
+        .filter_map(|root| by_root.remove(&root))
+        .collect()
+}
+
+/// A block's rows as a dense matrix over the columns they touch.
+fn dense(rows: &[&Row]) -> DMatrix<f64> {
+    let mut local = std::collections::HashMap::new();
+    for row in rows {
+        for &(c, _) in row.iter() {
+            let next = local.len();
+            local.entry(c).or_insert(next);
+        }
+    }
+    let mut m = DMatrix::zeros(rows.len(), local.len());
+    for (i, row) in rows.iter().enumerate() {
+        for &(c, v) in row.iter() {
+            m[(i, local[&c])] += v;
+        }
+    }
+    m
+}
 
 fn length_scale(model: &Model) -> f64 {
     let mut s: f64 = 0.0;
@@ -347,25 +438,32 @@ fn connectivity(model: &Model, sink: &mut Sink) {
     }
 }
 
-fn redundancy(model: &Model, rows: &[Vec<f64>], owner: &[usize], n: usize, sink: &mut Sink) {
-    let m = rows.len();
-    let j = DMatrix::from_fn(m, n, |i, k| rows[i][k]);
-    let jjt = &j * j.transpose();
-    let eig = SymmetricEigen::new(jjt);
-    let top = eig.eigenvalues.iter().fold(0.0f64, |a, x| a.max(x.abs()));
-    let tol = 1e-10 * top.max(1e-30) * m as f64;
-    let null: Vec<usize> = (0..m)
-        .filter(|&i| eig.eigenvalues[i].abs() <= tol)
-        .collect();
-    if null.is_empty() {
-        return;
+/// Dependent constraint equations (E0307): the null space of `J J^T`, block by block.
+fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
+    let m = r.rows.len();
+    let mut first = vec![usize::MAX; model.joints.len()];
+    for (i, &o) in owner.iter().enumerate().rev() {
+        first[o] = i;
     }
-    // The joints whose equations take part in a dependency.
-    let mut involved = vec![0.0f64; model.joints.len()];
-    for &c in &null {
-        for i in 0..m {
-            involved[owner[i]] = involved[owner[i]].max(eig.eigenvectors[(i, c)].abs());
+    let (mut involved, mut nulls) = (vec![0.0f64; model.joints.len()], 0);
+    for block in loop_blocks(model, r.cols) {
+        let rows: Vec<usize> = block
+            .iter()
+            .flat_map(|&j| (first[j]..m).take_while(move |&i| owner[i] == j))
+            .collect();
+        let jb = dense(&rows.iter().map(|&i| &r.rows[i]).collect::<Vec<_>>());
+        let eig = SymmetricEigen::new(&jb * jb.transpose());
+        let top = eig.eigenvalues.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+        let tol = 1e-10 * top.max(1e-30) * rows.len() as f64;
+        for c in (0..rows.len()).filter(|&c| eig.eigenvalues[c].abs() <= tol) {
+            nulls += 1;
+            for (k, &i) in rows.iter().enumerate() {
+                involved[owner[i]] = involved[owner[i]].max(eig.eigenvectors[(k, c)].abs());
+            }
         }
+    }
+    if nulls == 0 {
+        return;
     }
     let names: Vec<usize> = (0..model.joints.len())
         .filter(|&k| involved[k] > 1e-6)
@@ -378,9 +476,8 @@ fn redundancy(model: &Model, rows: &[Vec<f64>], owner: &[usize], n: usize, sink:
     let mut d = Diagnostic::error(
         Code::E0307,
         format!(
-            "redundant constraints: {list} lock the same motion ({} equation{} too many)",
-            null.len(),
-            if null.len() == 1 { "" } else { "s" }
+            "redundant constraints: {list} lock the same motion ({nulls} equation{} too many)",
+            if nulls == 1 { "" } else { "s" }
         ),
     );
     for &k in &names {
@@ -391,7 +488,7 @@ fn redundancy(model: &Model, rows: &[Vec<f64>], owner: &[usize], n: usize, sink:
     }
     sink.push(d.hint(format!(
         "the constraint Jacobian has rank {} for {m} equations at the initial configuration; free one of these joints (a spherical instead of a revolute, a cylindrical instead of a prismatic) or remove it",
-        m - null.len()
+        m - nulls
     )));
 }
 

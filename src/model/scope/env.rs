@@ -39,7 +39,7 @@ pub enum Named {
     Binding(BindingId),
     Decl(DeclId),
     /// Indexed declarations or instances, by index.
-    Family(BTreeMap<i64, Member>),
+    Family(Rc<BTreeMap<i64, Member>>),
     Instance(ScopeId),
     /// A component definition and the scope it was defined in.
     Component(Rc<Component>, ScopeId),
@@ -258,13 +258,14 @@ impl Env {
                         if map.contains_key(&i) {
                             return Err(dup(first, format!("{}[{i}]", name.name)));
                         }
-                        map.insert(i, member);
+                        Rc::make_mut(map).insert(i, member);
                     }
                     Some(_) => return Err(dup(first, name.name.clone())),
                     None => {
                         let mut map = BTreeMap::new();
                         map.insert(i, member);
-                        s.names.insert(name.name.clone(), Named::Family(map));
+                        s.names
+                            .insert(name.name.clone(), Named::Family(Rc::new(map)));
                     }
                 }
             }

@@ -10,6 +10,7 @@ use crate::diagnostics::{did_you_mean, Code, Diagnostic};
 use crate::source::Span;
 use crate::syntax::ast::{Expr, ExprKind, Path};
 use std::collections::BTreeMap;
+use std::rc::Rc;
 
 impl Env {
     /// Evaluates the index and argument expressions of a path in `scope`.
@@ -213,7 +214,7 @@ impl Env {
     /// An indexed family: a member, or the whole family where families are wanted.
     fn follow_family(
         &mut self,
-        map: BTreeMap<i64, Member>,
+        map: Rc<BTreeMap<i64, Member>>,
         seg: &Seg,
         rest: &[Seg],
         span: Span,
@@ -225,7 +226,10 @@ impl Env {
                     self.decls[*d].used = true;
                 }
             }
-            return Ok((Ref::Family(map.into_iter().collect()), rest.to_vec()));
+            return Ok((
+                Ref::Family(map.iter().map(|(k, m)| (*k, *m)).collect()),
+                rest.to_vec(),
+            ));
         }
         let Some((i, ispan)) = seg.index else {
             let (lo, hi) = (

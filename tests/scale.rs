@@ -1,0 +1,132 @@
+//! The compiler at any model size (issue 21): the rank checks run on every model, however
+//! large, and find the same faults far from the ground as near it; many diagnostics render
+//! in time linear in their number, summarised per code for people, every one in JSON.
+
+use crate::cli::{code, mbd, stderr};
+use mbd::diagnostics::{render_human, summarize, Code, Diagnostic};
+use mbd::settings::Request;
+
+/// A planar chain of `n` rods hinged end to end, pinned to the ground at its start, and
+/// `extra` declarations.
+fn chain(n: usize, extra: &str) -> String {
+    format!(
+        "model chain
+param l = 0.1 m
+gravity = (0, -9.81, 0) m/s^2
+ground earth
+for i in 1..={n} {{
+    rigid_rod rod[i] {{ from = ((i - 1) * l, 0, 0), to = (i * l, 0, 0), mass = 0.1 kg }}
+}}
+joint pin = revolute(earth, rod[1].start) {{ axis = z }}
+for i in 1..{n} {{
+    joint hinge[i] = revolute(rod[i].end, rod[i + 1].start) {{ axis = z }}
+}}
+{extra}
+solve hht {{ dt = 1 ms, until = 10 ms }}
+"
+    )
+}
+
+fn diagnostics(text: &str) -> Vec<Diagnostic> {
+    match mbd::compile("chain.mbd", text, &[], Request::default()) {
+        Ok(c) => c.warnings,
+        Err(f) => f.diagnostics,
+    }
+}
+
+/// 2,000 links are 12,000 virtual-motion columns: four times what the dense checks took
+/// before they were skipped without a word.
+#[test]
+fn a_chain_of_two_thousand_links_gets_every_rank_check() {
+    assert!(diagnostics(&chain(2000, "")).is_empty());
+    // A second hinge on the last joint: five equations too many, at the far end.
+    let d = diagnostics(&chain(
+        2000,
+        "joint again = revolute(rod[1999].end, rod[2000].start) { axis = z }",
+    ));
+    assert_eq!(d.len(), 1, "{:?}", d);
+    assert_eq!(d[0].code, Code::E0307);
+    assert_eq!(
+        d[0].message,
+        "redundant constraints: `hinge[1999]`, `again` lock the same motion (5 equations too many)"
+    );
+    assert!(d[0]
+        .hint
+        .as_deref()
+        .is_some_and(|h| h.contains("rank 10000 for 10005 equations")));
+    // A slender rod on a ball joint at the tip spins about its axis with nothing to stop it.
+    let d = diagnostics(&chain(
+        2000,
+        "rigid_rod tip { from = (200, 0, 0) m, to = (201, 0, 0) m, mass = 0.1 kg }\n\
+         joint ball = spherical(rod[2000].end, tip.start)",
+    ));
+    assert_eq!(d.len(), 1, "{:?}", d);
+    assert_eq!(d[0].code, Code::E0308);
+    assert_eq!(
+        d[0].message,
+        "`tip` can move without inertia or restraint: rotation about (1.000, 0.000, 0.000)"
+    );
+}
+
+/// A loop closed through the ground 50 links away: the whole loop is one block. In 3-D a
+/// planar loop of parallel hinges locks three motions twice (out of the plane), and the
+/// straight line it starts in locks its length twice: 4 equations too many.
+#[test]
+fn a_long_closed_loop_is_checked_as_one_block() {
+    let d = diagnostics(&chain(
+        50,
+        "joint close = revolute(earth @ (5, 0, 0) m, rod[50].end) { axis = z }",
+    ));
+    assert_eq!(d.len(), 1, "{:?}", d);
+    assert_eq!(d[0].code, Code::E0307);
+    assert!(
+        d[0].message.ends_with("(4 equations too many)"),
+        "{}",
+        d[0].message
+    );
+    assert_eq!(d[0].labels.len(), 51, "every joint of the loop takes part");
+}
+
+/// Many warnings of one code: ten shown, the rest counted; JSON lists every one. The window
+/// each report reads is its own lines, so the last line of a long file renders with its
+/// number.
+#[test]
+fn many_diagnostics_are_summarised_per_code_and_all_listed_in_json() {
+    let n = 2500;
+    let head = "model p\nground earth\npoint_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n\
+                joint rope = distance(earth, bob)\n";
+    let text: String = std::iter::once(head.to_string())
+        .chain((0..n).map(|i| format!("param p{i} = {i}\n")))
+        .chain(std::iter::once(
+            "solve hht { dt = 1 ms, until = 1 s }\n".into(),
+        ))
+        .collect();
+    let d = diagnostics(&text);
+    assert_eq!(d.len(), n);
+    let (shown, more) = summarize(&d, 10);
+    assert_eq!(shown.len(), 10);
+    assert_eq!(more, ["... and 2,490 more W0201 warnings"]);
+    let c = match mbd::compile("p.mbd", &text, &[], Request::default()) {
+        Ok(c) => c,
+        Err(f) => panic!("{:?}", f.diagnostics),
+    };
+    let last = render_human(&c.warnings[n - 1], &c.sources, false);
+    assert!(last.contains("2504 │ param p2499 = 2499"), "{last}");
+    assert!(last.contains("2503 │ param p2498 = 2498"), "{last}");
+    assert!(last.contains("[p.mbd:2504:1]"), "{last}");
+
+    let dir = std::env::temp_dir().join(format!("mbd-scale-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("params.mbd");
+    std::fs::write(&path, &text).expect("write model");
+    let p = path.to_string_lossy();
+    let o = mbd(&["check", &p]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert_eq!(err.matches("W0201").count(), 11, "{err}");
+    assert!(err.contains("... and 2,490 more W0201 warnings"), "{err}");
+    let o = mbd(&["check", &p, "--format", "json"]);
+    let json: serde_json::Value = serde_json::from_str(&stderr(&o)).expect("JSON diagnostics");
+    assert_eq!(json.as_array().map(|a| a.len()), Some(n));
+    let _ = std::fs::remove_dir_all(dir);
+}
