@@ -51,6 +51,7 @@ const CASES: &[(&str, &[Code])] = &[
     ("multiblade_azimuth", &[Code::E0227, Code::E0227]),
     ("center_of_mass_massless", &[Code::E0228, Code::E0228]),
     ("missing_solve", &[Code::E0229]),
+    ("run_cannot_finish", &[Code::E0230]),
     ("output_call_component", &[Code::E0212, Code::E0212]),
     ("redundant_constraints", &[Code::E0307]),
     ("massless_motion", &[Code::E0308]),
@@ -70,6 +71,7 @@ const CASES: &[(&str, &[Code])] = &[
 
 /// Codes snapshotted by the other tests of this file (run-time failures, `--set`, imports).
 const ELSEWHERE: &[Code] = &[
+    Code::E0104,
     Code::E0208,
     Code::E0217,
     Code::E0501,

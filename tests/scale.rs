@@ -3,6 +3,7 @@
 //! in time linear in their number, summarised per code for people, every one in JSON.
 
 use crate::cli::{code, mbd, stderr};
+use crate::common::repo;
 use mbd::diagnostics::{render_human, summarize, Code, Diagnostic};
 use mbd::settings::Request;
 
@@ -129,4 +130,94 @@ fn many_diagnostics_are_summarised_per_code_and_all_listed_in_json() {
     let json: serde_json::Value = serde_json::from_str(&stderr(&o)).expect("JSON diagnostics");
     assert_eq!(json.as_array().map(|a| a.len()), Some(n));
     let _ = std::fs::remove_dir_all(dir);
+}
+
+/// One expression holds at most 1,000 operators, which bounds the depth of every recursive
+/// pass over it: at the limit each kind of chain compiles, on a test thread's small stack;
+/// past it, a coded error, never a stack overflow.
+#[test]
+fn long_operator_chains_compile_up_to_the_limit_and_are_refused_past_it() {
+    let model = |value: &str| {
+        format!(
+            "model p\nground earth\nparam x = {value}\n\
+             point_mass bob {{ mass = x * 1 kg, at = (0, -1, 0) m }}\n\
+             joint rope = distance(earth, bob)\nsolve hht {{ dt = 1 ms, until = 1 s }}\n"
+        )
+    };
+    let chains = |n: usize| {
+        [
+            vec!["1"; n + 1].join(" + "),
+            vec!["1"; n + 1].join(" * "),
+            vec!["1"; n + 1].join(" ^ "),
+            format!("{}1", "-".repeat(n)),
+        ]
+    };
+    for value in chains(1000) {
+        let d = diagnostics(&model(&value));
+        assert!(d.iter().all(|d| d.code.is_warning()), "{:?}", d.first());
+    }
+    for value in chains(1001) {
+        let d = diagnostics(&model(&value));
+        assert_eq!(d.len(), 1);
+        assert_eq!(d[0].code, Code::E0101);
+        assert_eq!(
+            d[0].message,
+            "an expression of 1001 operators: more than 1000"
+        );
+    }
+    // 50,000 terms on one line, through the binary: coded, exit 1.
+    let dir = std::env::temp_dir().join(format!("mbd-chain-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let path = dir.join("long.mbd");
+    std::fs::write(&path, model(&vec!["1"; 50_000].join(" + "))).expect("write model");
+    let o = mbd(&["check", &path.to_string_lossy()]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    assert!(stderr(&o).contains("an expression of 49999 operators"));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// Bytes that are not UTF-8 are the model's fault (exit 1, E0104 at the first bad byte); a
+/// byte-order mark and CRLF line ends are accepted; a directory is a usage error (exit 2).
+#[test]
+fn file_encodings_get_a_coded_answer() {
+    let model = "model p\nground earth\npoint_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n\
+                 joint rope = distance(earth, bob)\nsolve hht { dt = 1 ms, until = 1 s }\n";
+    let dir = std::env::temp_dir().join(format!("mbd-bytes-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let write = |name: &str, bytes: &[u8]| {
+        let p = dir.join(name);
+        std::fs::write(&p, bytes).expect("write model");
+        p.to_string_lossy().to_string()
+    };
+    let mut latin1 = model.replace("model p", "model p # 20 \u{b0}").into_bytes();
+    let at = latin1
+        .iter()
+        .position(|&b| b == 0xC2)
+        .expect("the degree sign");
+    latin1.remove(at); // 0xB0 alone: Latin-1's degree sign
+    let o = mbd(&["check", &write("latin1.mbd", &latin1)]);
+    assert_eq!(code(&o), 1, "{}", stderr(&o));
+    let err = stderr(&o);
+    assert!(err.contains("E0104"), "{err}");
+    assert!(err.contains("byte 0xB0 at line 1, column 14"), "{err}");
+    let bom = [&[0xEF, 0xBB, 0xBF][..], model.as_bytes()].concat();
+    let o = mbd(&["check", &write("bom.mbd", &bom)]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = mbd(&[
+        "check",
+        &write("crlf.mbd", model.replace('\n', "\r\n").as_bytes()),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let o = mbd(&["check", &dir.to_string_lossy()]);
+    assert_eq!(code(&o), 2, "{}", stderr(&o));
+    assert!(stderr(&o).contains("is a directory"));
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let (d, sources) = match mbd::syntax::decode("latin1.mbd", latin1) {
+        Ok(_) => panic!("Latin-1 bytes decoded as UTF-8"),
+        Err(e) => e,
+    };
+    assert_eq!(d.code, Code::E0104);
+    insta::assert_snapshot!("not_utf8", render_human(&d, &sources, false));
+    assert!(repo("tests/ui").is_dir());
 }

@@ -1,7 +1,7 @@
 //! `mbd check`: a model's summary, or one stage of its compilation (`--emit`); a library
 //! file's components. Exit 1 when the model has errors.
 
-use super::{compile, read, report, say, Format, FsLoader, EXIT_MODEL};
+use super::{compile, read_as, report, say, Format, FsLoader, EXIT_MODEL};
 use clap::ValueEnum;
 use mbd::settings::Request;
 use std::process::ExitCode;
@@ -29,7 +29,7 @@ enum Emit {
 
 pub fn check(a: CheckArgs) -> ExitCode {
     let (path, format, sets) = (a.model.as_str(), a.format, a.set.as_slice());
-    let text = match read(path) {
+    let text = match read_as(path, format) {
         Ok(t) => t,
         Err(code) => return code,
     };

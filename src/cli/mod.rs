@@ -42,10 +42,25 @@ pub fn usage(msg: &str) -> ExitCode {
     ExitCode::from(EXIT_USAGE)
 }
 
-/// The model file's text; an unreadable file is a usage error.
+/// The model file's text; an unreadable file is a usage error, a file that is not UTF-8 a
+/// model error (E0104, exit 1).
 pub fn read(path: &str) -> Result<String, ExitCode> {
-    std::fs::read_to_string(path)
-        .map_err(|e| usage(&format!("cannot read model file `{path}`: {e}")))
+    read_as(path, Format::Human)
+}
+
+/// [`read`], its diagnostic in `format`.
+pub fn read_as(path: &str, format: Format) -> Result<String, ExitCode> {
+    if std::path::Path::new(path).is_dir() {
+        return Err(usage(&format!(
+            "`{path}` is a directory: give the path of a model file (`.mbd`)"
+        )));
+    }
+    let bytes =
+        std::fs::read(path).map_err(|e| usage(&format!("cannot read model file `{path}`: {e}")))?;
+    mbd::syntax::decode(path, bytes).map_err(|(d, sources)| {
+        report(&[d], &sources, format);
+        ExitCode::from(EXIT_MODEL)
+    })
 }
 
 /// Renders diagnostics on standard error.

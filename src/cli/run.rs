@@ -3,7 +3,7 @@
 //! simulation fails (the rows before the failure are kept).
 
 use super::progress::Steps;
-use super::{compile, read, report, runnable, sink, to_path, usage, Format, EXIT_RUNTIME};
+use super::{compile, read_as, report, runnable, sink, to_path, usage, Format, EXIT_RUNTIME};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mbd::settings::{Method, NewtonMode, Request, Rotations, Start};
 use std::process::ExitCode;
@@ -91,7 +91,7 @@ pub fn run(a: RunArgs) -> ExitCode {
         return usage(&bad.flag_message());
     }
     let (format, output) = (a.format, a.output.as_deref());
-    let text = match read(&a.model) {
+    let text = match read_as(&a.model, format) {
         Ok(t) => t,
         Err(code) => return code,
     };

@@ -39,6 +39,12 @@ instead of `m/s`), or a keyword used as a name.";
     E0102 = "E0102", "empty model file",
         "The file declares nothing. A model needs at least a `model NAME` header, a `ground`, one \
 body and a `solve` block. See models/pendulum.mbd for a complete example.";
+    E0104 = "E0104", "model file is not UTF-8 text",
+        "A model file is UTF-8 text, and this one holds a byte sequence that is not UTF-8: \
+often a file saved in Latin-1 or Windows-1252 (a `°`, `µ` or `é` in a comment), a binary file \
+given by mistake, or a file cut in the middle of a character. The report points at the first \
+bad byte (its line and column; the line is shown with the bad bytes replaced). Save the file \
+as UTF-8 or remove the character; a byte-order mark at the start is accepted.";
     E0103 = "E0103", "missing or repeated model header",
         "Every file describes one scene and starts with `model NAME \"title\"`. The header is \
 missing, or appears more than once.";
@@ -157,6 +163,12 @@ mass at all (a massless hub), so it has no centre of mass.";
 long. Add one at the top level: `solve hht { dt = 1 ms, until = 1 s }` (the method, the time \
 step or the number of steps, and the end time; section 13 of docs/language.md lists the \
 settings). Without a block, `mbd run` needs both `--until` and `--dt` (or `--steps`).";
+    E0230 = "E0230", "run cannot finish",
+        "The time step and the end time ask for more steps than a run may take (10^9, \
+`MAX_STEPS`): at a few microseconds a step that is hours of CPU for the smallest model, and \
+a step far below the motion's time scales adds round-off, not accuracy. Usually a unit slipped \
+(`dt = 1e-15 s` meant `1 ms`, `until = 1e6 s` meant `1 s`). Lengthen `dt` or shorten `until`; \
+`mbd run --dt` and `--until` override the solve block.";
     E0301 = "E0301", "joint connects a body to itself",
         "Both markers of a joint are on the same body, so the joint constrains nothing. Connect it \
 to another body or to ground.";

@@ -433,6 +433,9 @@ impl Written {
     }
 }
 
+/// Most steps a run may take: at a few microseconds a step, hours of CPU.
+pub const MAX_STEPS: usize = 1_000_000_000;
+
 impl Settings {
     /// The settings of a run: the command line's request laid over the `solve` block's, the
     /// defaults filled in, every value checked. Errors are coded diagnostics at the values
@@ -470,15 +473,29 @@ impl Settings {
             ]
         };
         let until = r.until.ok_or_else(|| missing("until", "1 s"))?;
-        let (dt, steps) = match (r.dt, r.steps) {
-            (_, Some(n)) => (until / n as f64, n),
-            (Some(d), None) => {
-                // The last step is shortened by at most round-off: dt is rounded to fit `until`.
-                let n = (until / d - 1e-9).ceil().max(1.0) as usize;
-                (until / n as f64, n)
-            }
+        let count = match (r.dt, r.steps) {
+            (_, Some(n)) => n as f64,
+            // The last step is shortened by at most round-off: dt is rounded to fit `until`.
+            (Some(d), None) => (until / d - 1e-9).ceil().max(1.0),
             (None, None) => return Err(missing("dt", "0.005 s")),
         };
+        if count > MAX_STEPS as f64 {
+            let field = if r.steps.is_some() {
+                Field::Steps
+            } else {
+                Field::Dt
+            };
+            return Err(vec![Diagnostic::error(
+                Code::E0230,
+                format!("the run takes {count:.3e} steps: more than {MAX_STEPS:.0e}, so it cannot finish"),
+            )
+            .at(file.span_of(field), "the step for this end time")
+            .hint(format!(
+                "lengthen the step or shorten `until` (now {until} s) so the run takes at most {MAX_STEPS:.0e} steps; `mbd run --dt` and `--until` override the solve block"
+            ))]);
+        }
+        let steps = count as usize;
+        let dt = until / count;
         let method = r.method.unwrap_or_default();
         Ok(Settings {
             method,

@@ -29,6 +29,10 @@ fn pratt() -> &'static PrattParser<Rule> {
 /// Deepest nesting of brackets the parser accepts (deeper input would exhaust the stack).
 const MAX_NESTING: usize = 128;
 
+/// Most operators one expression may hold, its brackets included: the expression tree is
+/// at most this deep, which bounds every recursive pass over it (parse, evaluation, drop).
+const MAX_OPERATORS: usize = 1000;
+
 /// Rejects absurdly deep nesting before the recursive parser sees it.
 fn check_nesting(text: &str, source: SourceId) -> Result<(), Diagnostic> {
     let mut depth = 0usize;
@@ -363,6 +367,25 @@ impl Cx {
     }
 
     fn expr(&self, p: Pair<Rule>) -> Parsed<Expr> {
+        let operators = p
+            .clone()
+            .into_inner()
+            .flatten()
+            .filter(|q| {
+                matches!(
+                    q.as_rule(),
+                    Rule::add | Rule::sub | Rule::mul | Rule::div | Rule::pow | Rule::neg
+                )
+            })
+            .count();
+        if operators > MAX_OPERATORS {
+            return Err(Diagnostic::error(
+                Code::E0101,
+                format!("an expression of {operators} operators: more than {MAX_OPERATORS}"),
+            )
+            .at(self.span(&p), "this expression")
+            .hint("split it into named parts with `let`, or generate it with a `for` loop"));
+        }
         pratt()
             .map_primary(|q| self.primary(q))
             .map_prefix(|op, rhs| {
