@@ -10,25 +10,8 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion};
 use mbd::settings::Request;
 
-/// The chain's text, `n` links of 0.1 m and 0.1 kg.
-pub fn chain(n: usize, steps: usize) -> String {
-    format!(
-        "model chain \"{n} rods on revolute hinges\"
-param l = 0.1 m
-gravity = (0, -9.81, 0) m/s^2
-ground earth
-for i in 1..={n} {{
-    rigid_rod rod[i] {{ from = ((i - 1) * l, 0, 0), to = (i * l, 0, 0), mass = 0.1 kg }}
-}}
-joint pin = revolute(earth, rod[1].start) {{ axis = z }}
-for i in 1..{n} {{
-    joint hinge[i] = revolute(rod[i].end, rod[i + 1].start) {{ axis = z }}
-}}
-output tip_y = rod[{n}].end.position.y
-solve hht(alpha = -0.1) {{ dt = 1 ms, until = {steps} ms }}
-"
-    )
-}
+mod common;
+use common::chain;
 
 /// Steps of the longer run.
 const STEPS: usize = 11;

@@ -99,9 +99,11 @@ fn restraint_rows(model: &Model, r: &mut Rows) {
     }
 }
 
-/// For each node whose own inertia rows leave motions free, an orthonormal basis of those
-/// motions (in its own columns); and `top`, the largest squared norm of a row (the scale of
-/// the tolerance).
+/// For each body whose own inertia leaves motions free, a basis of those motions (in its own
+/// columns, unit columns); and `top`, the largest squared norm of a row (the scale of the
+/// tolerance). Shortness is judged in SI (the mass matrix `[m, m c~^T; m c~, J + m c~^T c~]`)
+/// against the model's largest entry, not in the rows' scaled rotations: a small body far
+/// from the origin is not short of inertia. Beam nodes never are (their mass matrix is full).
 fn short_of_inertia(
     r: &Rows,
     node_of: &[usize],
@@ -113,22 +115,51 @@ fn short_of_inertia(
         t.max(row.iter().map(|(_, v)| v * v).sum::<f64>())
     });
     let mut gram = vec![nalgebra::Matrix6::<f64>::zeros(); cols.nodes.len()];
+    // Rotation columns are scaled by 1/scale in the rows: back to SI.
+    let si = |k: usize, i: usize| {
+        if i >= 3 && cols.rotates[k] {
+            r.scale
+        } else {
+            1.0
+        }
+    };
     for row in &r.rows[from..from + inertia] {
         for &(a, va) in row {
             for &(b, vb) in row {
                 let k = node_of[a];
-                gram[k][(a - cols.start[k], b - cols.start[k])] += va * vb;
+                let (i, j) = (a - cols.start[k], b - cols.start[k]);
+                gram[k][(i, j)] += va * vb * si(k, i) * si(k, j);
             }
         }
     }
-    let tol = 1e-12 * top.max(1e-30) * cols.n as f64;
-    let short = (0..cols.nodes.len())
+    let body = |k: usize| matches!(cols.nodes[k], Node::Body { .. });
+    let eigs: Vec<_> = (0..cols.nodes.len())
         .map(|k| {
             let w = cols.width(k);
-            let eig = SymmetricEigen::new(gram[k].view((0, 0), (w, w)).into_owned());
+            SymmetricEigen::new(gram[k].view((0, 0), (w, w)).into_owned())
+        })
+        .collect();
+    let largest = eigs
+        .iter()
+        .flat_map(|e| e.eigenvalues.iter().copied())
+        .fold(0.0f64, f64::max);
+    let tol = 1e-12 * largest.max(1e-300);
+    let short = (0..cols.nodes.len())
+        .map(|k| {
+            let eig = &eigs[k];
+            let w = cols.width(k);
             let free: Vec<usize> = (0..w).filter(|&q| eig.eigenvalues[q] <= tol).collect();
-            (!free.is_empty())
-                .then(|| DMatrix::from_fn(w, free.len(), |i, q| eig.eigenvectors[(i, free[q])]))
+            (body(k) && !free.is_empty()).then(|| {
+                // In the rows' columns: rotations times `scale`, each column of unit length.
+                let mut b = DMatrix::from_fn(w, free.len(), |i, q| {
+                    eig.eigenvectors[(i, free[q])] * si(k, i)
+                });
+                for mut c in b.column_iter_mut() {
+                    let n = c.norm();
+                    c /= n;
+                }
+                b
+            })
         })
         .collect();
     (short, top)
@@ -207,11 +238,11 @@ fn unrestrained(model: &Model, r: &Rows, from: usize, inertia: usize, sink: &mut
     for k in 0..cols.nodes.len() {
         node_of[cols.start[k]..cols.start[k] + cols.width(k)].fill(k);
     }
-    let (short, top) = short_of_inertia(r, &node_of, from, inertia);
+    let (basis, top) = short_of_inertia(r, &node_of, from, inertia);
     let tol = 1e-12 * top.max(1e-30) * n as f64;
-    let held = held(r, &node_of, &short, tol);
+    let held = held(r, &node_of, &basis, tol);
     let short: Vec<bool> = (0..cols.nodes.len())
-        .map(|k| short[k].is_some() && !held[k])
+        .map(|k| basis[k].is_some() && !held[k])
         .collect();
     if !short.iter().any(|&s| s) {
         return;
@@ -245,41 +276,44 @@ fn unrestrained(model: &Model, r: &Rows, from: usize, inertia: usize, sink: &mut
     groups.sort_by_key(|g| g.0[0]);
     for (nodes, rows) in groups {
         // The group's columns in node order, so a null vector reads node by node.
-        let mut local = vec![usize::MAX; n];
+        // A null vector moves each node within its free motions: `v_k = N_k z_k`.
+        let mut at = vec![usize::MAX; cols.nodes.len()];
         let mut width = 0;
         for &k in &nodes {
-            for c in cols.start[k]..cols.start[k] + cols.width(k) {
-                local[c] = width;
-                width += 1;
-            }
+            at[k] = width;
+            width += basis[k].as_ref().map_or(0, |b| b.ncols());
         }
         let mut a = DMatrix::<f64>::zeros(rows.len(), width);
         for (i, row) in rows.iter().enumerate() {
             for &(c, v) in row.iter() {
-                a[(i, local[c])] += v;
+                let k = node_of[c];
+                if let Some(b) = &basis[k] {
+                    for q in 0..b.ncols() {
+                        a[(i, at[k] + q)] += v * b[(c - cols.start[k], q)];
+                    }
+                }
             }
         }
         let eig = SymmetricEigen::new(a.transpose() * &a);
         let Some(c) = (0..width).find(|&c| eig.eigenvalues[c].abs() <= tol) else {
             continue;
         };
-        let v = eig.eigenvectors.column(c);
-        let at = |k: usize| local[cols.start[k]];
+        let z = eig.eigenvectors.column(c);
+        let motion = |k: usize| -> Vec<f64> {
+            let b = basis[k].as_ref().expect("a short node");
+            (0..b.nrows())
+                .map(|i| (0..b.ncols()).map(|q| b[(i, q)] * z[at[k] + q]).sum())
+                .collect()
+        };
         // The node that moves most in this motion, and how.
         let (k, _) = nodes
             .iter()
-            .map(|&k| {
-                let s = at(k);
-                (
-                    k,
-                    (0..cols.width(k)).map(|i| v[s + i] * v[s + i]).sum::<f64>(),
-                )
-            })
+            .map(|&k| (k, motion(k).iter().map(|x| x * x).sum::<f64>()))
             .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
-        let s = at(k);
-        let t = [v[s], v[s + 1], v[s + 2]];
+        let v = motion(k);
+        let t = [v[0], v[1], v[2]];
         let rot = if cols.rotates[k] {
-            [v[s + 3], v[s + 4], v[s + 5]]
+            [v[3], v[4], v[5]]
         } else {
             [0.0; 3]
         };
