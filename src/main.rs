@@ -48,7 +48,14 @@ fn main() -> ExitCode {
             return ExitCode::from(if e.use_stderr() { cli::EXIT_USAGE } else { 0 });
         }
     };
-    match cli.command {
+    // Ctrl-C: runs stop after their step, keeping their rows; a second one ends at once.
+    let _ = ctrlc::set_handler(|| {
+        if mbd::solve::interrupted() {
+            std::process::exit(cli::EXIT_INTERRUPTED.into());
+        }
+        mbd::solve::interrupt();
+    });
+    let code = match cli.command {
         Command::Run(args) => cli::run::run(args),
         Command::Modes(args) => cli::modes::modes(args),
         Command::Check(args) => cli::check::check(args),
@@ -56,5 +63,9 @@ fn main() -> ExitCode {
         Command::Study(args) => cli::study::study(args),
         Command::Stability(args) => cli::stability::stability(args),
         Command::Explain { code } => cli::explain::explain(&code),
+    };
+    if mbd::solve::interrupted() {
+        return ExitCode::from(cli::EXIT_INTERRUPTED);
     }
+    code
 }

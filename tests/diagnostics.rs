@@ -72,6 +72,7 @@ const CASES: &[(&str, &[Code])] = &[
 /// Codes snapshotted by the other tests of this file (run-time failures, `--set`, imports).
 const ELSEWHERE: &[Code] = &[
     Code::E0104,
+    Code::E0607,
     Code::E0208,
     Code::E0217,
     Code::E0501,

@@ -220,10 +220,37 @@ fn run_limited(
         .stderr(std::process::Stdio::piped())
         .spawn()
         .expect("mbd runs");
+    // Read both pipes as the child writes: a report longer than a pipe holds (a 2 MB line
+    // shown in a diagnostic) must not block the child and look like a hang.
+    let drain = |pipe: Option<Box<dyn std::io::Read + Send>>| {
+        std::thread::spawn(move || {
+            let mut buf = Vec::new();
+            if let Some(mut p) = pipe {
+                let _ = p.read_to_end(&mut buf);
+            }
+            buf
+        })
+    };
+    let out = drain(
+        child
+            .stdout
+            .take()
+            .map(|p| Box::new(p) as Box<dyn std::io::Read + Send>),
+    );
+    let err = drain(
+        child
+            .stderr
+            .take()
+            .map(|p| Box::new(p) as Box<dyn std::io::Read + Send>),
+    );
     let started = std::time::Instant::now();
     loop {
-        if child.try_wait().expect("wait").is_some() {
-            return Some(child.wait_with_output().expect("output"));
+        if let Some(status) = child.try_wait().expect("wait") {
+            return Some(std::process::Output {
+                status,
+                stdout: out.join().unwrap_or_default(),
+                stderr: err.join().unwrap_or_default(),
+            });
         }
         if started.elapsed() > limit {
             let _ = child.kill();
@@ -290,5 +317,99 @@ fn mutated_models_exit_zero_or_one_and_run_or_fail_cleanly() {
     assert!(
         checked == 16 * corpus.len() && ran >= 10,
         "checked {checked}, ran {ran}"
+    );
+}
+
+/// Byte-level mutations through the binary (issue 21): bytes that are not UTF-8, NUL, deep
+/// nesting, a very long line, a long operator chain, and a generated 50,000-line model. Each
+/// gets an answer within 20 s: exit 0, or exit 1 with a coded diagnostic; never a panic, a
+/// crash (a signal) or a hang.
+#[test]
+fn byte_level_mutations_get_coded_answers() {
+    use std::ffi::OsStr;
+    use std::time::Duration;
+    let corpus = corpus();
+    let mut rng = Lcg(0x0b17_e5ed);
+    let dir = std::env::temp_dir().join(format!("mbd-bytes-fuzz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let mut inputs: Vec<(String, Vec<u8>)> = Vec::new();
+    for (name, text) in corpus.iter().step_by(3) {
+        let bytes = text.as_bytes();
+        let at = |rng: &mut Lcg| {
+            let mut k = rng.below(bytes.len() + 1);
+            while !text.is_char_boundary(k) {
+                k -= 1;
+            }
+            k
+        };
+        let splice = |k: usize, insert: &[u8]| [&bytes[..k], insert, &bytes[k..]].concat();
+        for insert in [
+            &[0xFFu8][..],
+            &[0xC3][..],
+            &[0xE2, 0x82][..],
+            &[0x00][..],
+            &b"(((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((((("[..],
+        ] {
+            let k = at(&mut rng);
+            inputs.push((format!("{name} + {insert:02X?} at {k}"), splice(k, insert)));
+        }
+        let long_line = format!("\n# {}\n", "x".repeat(2_000_000));
+        inputs.push((
+            format!("{name} + a 2 MB line"),
+            splice(at(&mut rng), long_line.as_bytes()),
+        ));
+        let chain = format!("\nparam zz = {}\n", vec!["1"; 50_000].join(" + "));
+        inputs.push((
+            format!("{name} + a 50,000-term sum"),
+            [bytes, chain.as_bytes()].concat(),
+        ));
+    }
+    // 50,000 params, each using the one before: a dependency chain evaluated from its end.
+    let generated: String = std::iter::once(
+        "model big\nground earth\npoint_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n\
+         joint rope = distance(earth, bob)\nparam p0 = 0 m\n"
+            .to_string(),
+    )
+    .chain((1..50_000).map(|i| format!("param p{i} = {i} m + p{} * 0\n", i - 1)))
+    .chain(std::iter::once(
+        "initial velocity of bob = (p49999 / 1 s, 0, 0)\nsolve hht { dt = 1 ms, until = 1 s }\n"
+            .into(),
+    ))
+    .collect();
+    inputs.push((
+        "a generated 50,000-line model".into(),
+        generated.into_bytes(),
+    ));
+    let code_re = |s: &str| {
+        s.as_bytes()
+            .windows(5)
+            .any(|w| (w[0] == b'E' || w[0] == b'W') && w[1..].iter().all(u8::is_ascii_digit))
+    };
+    let (mut accepted, mut rejected) = (0, 0);
+    for (k, (what, input)) in inputs.iter().enumerate() {
+        let path = dir.join(format!("b{k}.mbd"));
+        std::fs::write(&path, input).expect("write");
+        let o = run_limited(
+            &[OsStr::new("check"), path.as_os_str()],
+            Duration::from_secs(20),
+        )
+        .unwrap_or_else(|| panic!("mbd check hung on {what}"));
+        let err = String::from_utf8_lossy(&o.stderr);
+        match o.status.code() {
+            Some(0) => accepted += 1,
+            Some(1) if code_re(&err) => rejected += 1,
+            c => panic!(
+                "mbd check exited {c:?} on {what}: {}",
+                &err[..err.len().min(2000)]
+            ),
+        }
+        if input.contains(&0xFF) {
+            assert!(err.contains("E0104"), "{what}: {err}");
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(
+        rejected > inputs.len() / 2 && accepted >= 1,
+        "accepted {accepted}, rejected {rejected}"
     );
 }

@@ -224,3 +224,64 @@ fn file_encodings_get_a_coded_answer() {
     insta::assert_snapshot!("not_utf8", render_human(&d, &sources, false));
     assert!(repo("tests/ui").is_dir());
 }
+
+/// Ctrl-C (SIGINT) stops a run after its step: exit 130, E0607 saying when, and a CSV of
+/// whole rows, every one computed before the stop.
+#[test]
+fn ctrl_c_stops_a_run_and_keeps_its_rows() {
+    let dir = std::env::temp_dir().join(format!("mbd-sigint-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let csv = dir.join("windmill.csv");
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mbd"))
+        .args(["run", "models/windmill.mbd", "--until", "1000", "-o"])
+        .arg(&csv)
+        .current_dir(repo(""))
+        .env("NO_COLOR", "1")
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("start mbd");
+    // Wait for rows to be written (the run takes minutes), then interrupt it.
+    let start = std::time::Instant::now();
+    while std::fs::metadata(&csv).map_or(0, |m| m.len()) < 100_000 {
+        assert!(start.elapsed().as_secs() < 60, "no rows after a minute");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let kill = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(kill.success());
+    let o = child.wait_with_output().expect("mbd ends");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(130), "{err}");
+    assert!(err.contains("E0607"), "{err}");
+    assert!(err.contains("run interrupted at t = "), "{err}");
+    let text = std::fs::read_to_string(&csv).expect("the CSV");
+    assert!(text.ends_with('\n'), "the last row is whole");
+    let rows: Vec<&str> = text.lines().collect();
+    let width = rows[0].split(',').count();
+    assert!(rows.len() > 100, "{} rows", rows.len());
+    assert!(rows.iter().all(|r| r.split(',').count() == width));
+    assert!(rows.len() < 2_000_000, "the run went on to the end");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// E0607 as a person reads it.
+#[test]
+fn an_interrupted_run_says_when_and_that_its_rows_are_kept() {
+    let text = crate::common::read("models/pendulum.mbd");
+    let c = match mbd::compile("models/pendulum.mbd", &text, &[], Request::default()) {
+        Ok(c) => c,
+        Err(f) => panic!("{:?}", f.diagnostics),
+    };
+    let f = mbd::solve::RuntimeFailure {
+        kind: mbd::solve::FailureKind::Interrupted,
+        t: 0.25,
+        step: 51,
+        entity: None,
+        detail: "stopped before step 51 of 200".into(),
+    };
+    let d = c.failure_diagnostic(&f);
+    assert_eq!(d.code, Code::E0607);
+    insta::assert_snapshot!("run_interrupted", render_human(&d, &c.sources, false));
+}

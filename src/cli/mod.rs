@@ -2,7 +2,8 @@
 //! compiling it with its diagnostics reported, usage errors, the output files and the
 //! progress. The only code that reads files and renders reports.
 //! Exit codes: 0 success; 1 the model has errors; 2 bad command-line usage; 3 the simulation
-//! failed at run time (the CSV keeps every row computed before the failure).
+//! failed at run time (the CSV keeps every row computed before the failure); 130 stopped by
+//! Ctrl-C (E0607, the rows so far kept).
 
 pub mod check;
 pub mod explain;
@@ -28,6 +29,8 @@ use std::process::ExitCode;
 pub const EXIT_MODEL: u8 = 1;
 pub const EXIT_USAGE: u8 = 2;
 pub const EXIT_RUNTIME: u8 = 3;
+/// Stopped by Ctrl-C (128 + SIGINT, as shells report it).
+pub const EXIT_INTERRUPTED: u8 = 130;
 
 /// The diagnostics format (`--format`).
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]

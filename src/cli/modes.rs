@@ -4,8 +4,8 @@
 use super::progress::Evaluations;
 use super::swept::Swept;
 use super::{
-    compile, create_outputs, draw, exit_unless_failed, read, report, sink, to_path, usage, Format,
-    Jobs, EXIT_MODEL, EXIT_RUNTIME,
+    compile, create_outputs, draw, exit_unless_failed, read_as, report, sink, to_path, usage,
+    Format, Jobs, EXIT_MODEL, EXIT_RUNTIME,
 };
 use mbd::settings::Request;
 use mbd::solve::modes::{Frame, Modes};
@@ -78,7 +78,7 @@ pub fn modes(a: ModesArgs) -> ExitCode {
     if a.count == 0 {
         return usage("--count must be at least 1");
     }
-    let text = match read(&a.model) {
+    let text = match read_as(&a.model, a.format) {
         Ok(t) => t,
         Err(code) => return code,
     };

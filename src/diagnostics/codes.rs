@@ -253,6 +253,11 @@ some direction, or constraints may be redundant.";
         "The requested combination of time integrator and options is not available: time finite \
 elements (`fet`) integrate rotations incrementally, so `rotations = conformal` applies to the \
 Newmark family (`hht`, `generalized_alpha`) only.";
+    E0607 = "E0607", "run interrupted",
+        "The run was stopped by Ctrl-C (SIGINT) between two steps: nothing failed. The output \
+keeps every row computed before it (the CSV's last row is whole), and `mbd` exits with code \
+130. In a sweep or a study every run still to go stops the same way and what was finished \
+is written. A second Ctrl-C ends the process at once.";
     E0605 = "E0605", "no steady motion for modal analysis",
         "`mbd modes` linearizes the equations about the initial state, and that linearization has \
 modes only if the state is a steady motion: an equilibrium (at rest, or a uniform translation), \

@@ -27,6 +27,21 @@ pub enum FailureKind {
     Singular,
     NonFinite,
     Unsupported,
+    /// Stopped by [`interrupt`] (Ctrl-C) between steps.
+    Interrupted,
+}
+
+static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Asks every run in this process to stop after its current step (the CLI's Ctrl-C handler):
+/// each ends with a [`FailureKind::Interrupted`] failure, its rows so far written.
+pub fn interrupt() {
+    INTERRUPTED.store(true, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether [`interrupt`] was called.
+pub fn interrupted() -> bool {
+    INTERRUPTED.load(std::sync::atomic::Ordering::Relaxed)
 }
 
 /// A run-time failure: when, where and what.

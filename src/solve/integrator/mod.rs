@@ -323,6 +323,15 @@ impl<'s> Integrator<'s> {
     ) -> Result<(), Stop<E>> {
         let (t0, dt) = (self.cur.t, self.set.dt);
         for k in 1..=self.set.steps {
+            if super::interrupted() {
+                return Err(Stop::Failed(RuntimeFailure {
+                    kind: FailureKind::Interrupted,
+                    t: self.cur.t,
+                    step: k,
+                    entity: None,
+                    detail: format!("stopped before step {k} of {}", self.set.steps),
+                }));
+            }
             self.step(k, dt).map_err(Stop::Failed)?;
             self.cur.t = t0 + k as f64 * dt;
             each(k, self).map_err(Stop::Stopped)?;
