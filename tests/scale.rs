@@ -232,7 +232,7 @@ fn ctrl_c_stops_a_run_and_keeps_its_rows() {
     let dir = std::env::temp_dir().join(format!("mbd-sigint-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp dir");
     let csv = dir.join("windmill.csv");
-    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_mbd"))
+    let child = std::process::Command::new(env!("CARGO_BIN_EXE_mbd"))
         .args(["run", "models/windmill.mbd", "--until", "1000", "-o"])
         .arg(&csv)
         .current_dir(repo(""))

@@ -50,6 +50,10 @@ impl Pattern {
     }
 }
 
+/// Per element with inertia or damping: its index, and each frame among its unknowns with
+/// the local positions of its translation and rotation unknowns.
+type Rated = Vec<(usize, Vec<(usize, [usize; 6])>)>;
+
 /// Assembles residuals and the iteration matrix of a [`System`].
 pub struct Assembler {
     pub pattern: Pattern,
@@ -63,7 +67,7 @@ pub struct Assembler {
     local2: Vec<f64>,
     /// Per element with inertia or damping: the frames among its unknowns, each with the
     /// local positions of its translation and rotation unknowns.
-    rated: Vec<(usize, Vec<(usize, [usize; 6])>)>,
+    rated: Rated,
     pub residual: Residual,
     /// Generalized momenta `P = M(q) V` and transport terms `G` (`dP/dt + G = F^I`).
     pub momentum: Vec<f64>,
@@ -108,7 +112,7 @@ impl Assembler {
 
     /// The elements whose tangent depends on the rates of frames (`System::is_frame`), with
     /// each frame's unknowns in local positions (a frame counts only with all six).
-    fn rated(sys: &System, indices: &[Vec<usize>]) -> Vec<(usize, Vec<(usize, [usize; 6])>)> {
+    fn rated(sys: &System, indices: &[Vec<usize>]) -> Rated {
         let mut frame_at = vec![None; sys.len()];
         for (k, &r) in sys.rotations.iter().enumerate() {
             if sys.is_frame(k) {
