@@ -91,6 +91,61 @@ fn a_long_closed_loop_is_checked_as_one_block() {
     assert_eq!(d[0].labels.len(), 51, "every joint of the loop takes part");
 }
 
+/// Blocks over 600 columns are reduced on a spanning tree instead of factored densely: on
+/// each side of that size (90 links: 540 columns, dense; 110 links: 660, tree) the same
+/// loops give the same dependencies, and a loop of 2,000 links (12,000 columns) is checked.
+#[test]
+fn large_loops_reduced_on_a_tree_agree_with_the_dense_check() {
+    let closing = |n: usize, kind: &str| -> String {
+        let x = n as f64 / 10.0;
+        match kind {
+            "spherical" => format!("joint close = spherical(earth @ ({x}, 0, 0) m, rod[{n}].end)"),
+            _ => format!(
+                "joint close = revolute(earth @ ({x}, 0, 0) m, rod[{n}].end) {{ axis = z }}"
+            ),
+        }
+    };
+    // Out of the plane 3 (revolute) or 1 (spherical), and the straight line's length once
+    // more; bent into an arch, no straight line.
+    for (kind, bent, too_many) in [
+        ("revolute", false, 4),
+        ("spherical", false, 2),
+        ("revolute", true, 3),
+    ] {
+        for n in [90, 110] {
+            let mut text = chain(n, &closing(n, kind));
+            if bent {
+                text = text.replace(
+                    "from = ((i - 1) * l, 0, 0), to = (i * l, 0, 0)",
+                    &format!("from = ((i - 1) * l, 0.01 * (i - 1) * ({n} - i + 1) * l, 0), to = (i * l, 0.01 * i * ({n} - i) * l, 0)"),
+                );
+            }
+            let d = diagnostics(&text);
+            assert_eq!(d.len(), 1, "{kind} {n}: {:?}", d);
+            assert_eq!(d[0].code, Code::E0307);
+            let tail = format!("({too_many} equations too many)");
+            assert!(
+                d[0].message.ends_with(&tail),
+                "{kind} {n}: {}",
+                d[0].message
+            );
+            assert_eq!(
+                d[0].labels.len(),
+                n + 1,
+                "{kind} {n}: every joint takes part"
+            );
+        }
+    }
+    let d = diagnostics(&chain(2000, &closing(2000, "revolute")));
+    assert_eq!(d.len(), 1, "{:?}", d);
+    assert!(
+        d[0].message.ends_with("(4 equations too many)"),
+        "{}",
+        d[0].message
+    );
+    assert_eq!(d[0].labels.len(), 2001);
+}
+
 /// Many warnings of one code: ten shown, the rest counted; JSON lists every one. The window
 /// each report reads is its own lines, so the last line of a long file renders with its
 /// number.

@@ -19,6 +19,14 @@ use nalgebra::{DMatrix, SymmetricEigen};
 
 mod blocks;
 mod massless;
+mod report;
+mod tree;
+
+pub use report::report;
+
+/// Blocks with more columns than this are reduced on a spanning tree (`tree.rs`), smaller
+/// ones factored densely.
+const DENSE_BLOCK: usize = 600;
 
 /// Columns of a node in the virtual-motion vector.
 struct Columns {
@@ -446,11 +454,29 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
         first[o] = i;
     }
     let (mut involved, mut nulls) = (vec![0.0f64; model.joints.len()], 0);
+    let rows_of = |j: usize| first[j]..(first[j]..m).find(|&i| owner[i] != j).unwrap_or(m);
     for block in loop_blocks(model, r.cols) {
-        let rows: Vec<usize> = block
+        let rows: Vec<usize> = block.iter().flat_map(|&j| rows_of(j)).collect();
+        let mut nodes: Vec<usize> = block
             .iter()
-            .flat_map(|&j| (first[j]..m).take_while(move |&i| owner[i] == j))
+            .flat_map(|&j| vertices(model, r.cols, &model.joints[j]))
             .collect();
+        nodes.sort_unstable();
+        nodes.dedup();
+        let width: usize = nodes
+            .iter()
+            .filter(|&&k| k < r.cols.nodes.len())
+            .map(|&k| r.cols.width(k))
+            .sum();
+        if width > DENSE_BLOCK {
+            for dep in tree::dependencies(model, r, &block, &rows_of) {
+                nulls += 1;
+                for (i, v) in dep {
+                    involved[owner[i]] = involved[owner[i]].max(v.abs());
+                }
+            }
+            continue;
+        }
         let jb = dense(&rows.iter().map(|&i| &r.rows[i]).collect::<Vec<_>>());
         let eig = SymmetricEigen::new(&jb * jb.transpose());
         let top = eig.eigenvalues.iter().fold(0.0f64, |a, x| a.max(x.abs()));
@@ -490,104 +516,4 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
         "the constraint Jacobian has rank {} for {m} equations at the initial configuration; free one of these joints (a spherical instead of a revolute, a cylindrical instead of a prismatic) or remove it",
         m - nulls
     )));
-}
-
-/// The topology as `mbd check` prints it.
-pub fn report(model: &Model) -> String {
-    use std::fmt::Write;
-    let d = &model.dofs;
-    let mut s = String::new();
-    let nodes = model.bodies.len() + model.beams.iter().map(|b| b.nodes.len()).sum::<usize>();
-    let coords = d.len() - d.multipliers() - d.extras();
-    let _ = writeln!(s, "bodies:");
-    for b in &model.bodies {
-        let kind = match b.kind {
-            BodyKind::PointMass => "point mass, 3 DOFs",
-            BodyKind::Rigid => "rigid, 6 DOFs",
-        };
-        let _ = writeln!(s, "  {:<24} {kind}, mass {} kg", b.name, b.mass);
-    }
-    for b in &model.beams {
-        let _ = writeln!(
-            s,
-            "  {:<24} beam, {} elements of {} nodes, {} nodes, {} DOFs",
-            b.name,
-            b.elements,
-            b.order,
-            b.nodes.len(),
-            6 * b.nodes.len()
-        );
-    }
-    if !model.joints.is_empty() {
-        let _ = writeln!(s, "joints:");
-        for j in &model.joints {
-            let extra = if j.kind.extra_unknowns() > 0 {
-                " + angle"
-            } else {
-                ""
-            };
-            let _ = writeln!(
-                s,
-                "  {:<24} {} ({} -> {}), {} multipliers{extra}",
-                j.name,
-                j.kind.name(),
-                j.markers[0].text,
-                j.markers[1].text,
-                j.kind.multipliers()
-            );
-        }
-    }
-    if !model.springs.is_empty() || !model.loads.is_empty() {
-        let _ = writeln!(
-            s,
-            "springs and loads: {} springs/dampers, {} loads",
-            model.springs.len(),
-            model.loads.len()
-        );
-    }
-    let _ = writeln!(
-        s,
-        "unknowns: {} ({} nodes, {coords} DOFs, {} extra unknowns, {} multipliers), bandwidth {}",
-        d.len(),
-        nodes,
-        d.extras(),
-        d.multipliers(),
-        d.bandwidth
-    );
-    let _ = write!(s, "order:");
-    let mut line = String::new();
-    let mut k = 0;
-    while k < d.unknowns.len() {
-        let u = d.unknowns[k];
-        let (label, width) = match u {
-            dofs::Unknown::Translation { body, .. } => {
-                let w = if model.bodies[body].kind == BodyKind::Rigid {
-                    6
-                } else {
-                    3
-                };
-                (model.bodies[body].name.clone(), w)
-            }
-            dofs::Unknown::NodeTranslation { beam, node, .. } => {
-                (format!("{}.node[{node}]", model.beams[beam].name), 6)
-            }
-            dofs::Unknown::JointAngle { joint } => {
-                (format!("{}.angle", model.joints[joint].name), 1)
-            }
-            dofs::Unknown::Multiplier { joint, .. } => (
-                format!("λ {}", model.joints[joint].name),
-                model.joints[joint].kind.multipliers(),
-            ),
-            _ => (String::from("?"), 1),
-        };
-        let item = format!(" {label} [{k}..{}]", k + width - 1);
-        if line.len() + item.len() > 90 {
-            let _ = writeln!(s, "{line}");
-            line = String::from("      ");
-        }
-        line.push_str(&item);
-        k += width;
-    }
-    let _ = write!(s, "{line}");
-    s
 }
