@@ -73,6 +73,7 @@ const CASES: &[(&str, &[Code])] = &[
 const ELSEWHERE: &[Code] = &[
     Code::E0104,
     Code::E0607,
+    Code::W0302,
     Code::E0208,
     Code::E0217,
     Code::E0501,

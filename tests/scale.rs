@@ -340,3 +340,30 @@ fn an_interrupted_run_says_when_and_that_its_rows_are_kept() {
     assert_eq!(d.code, Code::E0607);
     insta::assert_snapshot!("run_interrupted", render_human(&d, &c.sources, false));
 }
+
+/// Bodies short of inertia that the joints do not hold are factored densely in groups: a
+/// floating chain of 100 massless bodies gets E0308; one of 600 (3,600 free motions) would
+/// take minutes, so it gets W0302, which says so, instead of a hang.
+#[test]
+fn a_large_group_of_massless_bodies_is_reported_unchecked_not_hung() {
+    let floating = |n: usize| {
+        format!(
+            "model m\nground earth\n\
+             for i in 1..={n} {{ rigid b[i] {{ mass = 0 kg, at = (i, 0, 0) m }} }}\n\
+             for i in 1..{n} {{ joint ball[i] = spherical(b[i] @ (0.5, 0, 0) m, b[i + 1] @ (-0.5, 0, 0) m) }}\n\
+             solve hht {{ dt = 1 ms, until = 1 s }}\n"
+        )
+    };
+    let d = diagnostics(&floating(100));
+    let codes: Vec<Code> = d.iter().map(|d| d.code).collect();
+    assert_eq!(codes, [Code::W0301, Code::E0308], "{d:?}");
+    let text = floating(600);
+    let d = diagnostics(&text);
+    let codes: Vec<Code> = d.iter().map(|d| d.code).collect();
+    assert_eq!(codes, [Code::W0301, Code::W0302], "{d:?}");
+    let c = match mbd::compile("m.mbd", &text, &[], Request::default()) {
+        Ok(c) => c,
+        Err(f) => panic!("{:?}", f.diagnostics),
+    };
+    insta::assert_snapshot!("massless_unchecked", render_human(&d[1], &c.sources, false));
+}

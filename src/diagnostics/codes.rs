@@ -286,6 +286,14 @@ Write `3 deg`, or `3 rad` to keep radians and silence the warning.";
         "No chain of joints, springs or beams connects the body to a ground, so it floats: the \
 warning names the free motions. That is right for a free-flight test and wrong almost everywhere \
 else; with gravity, the body falls.";
+    W0302 = "W0302", "motions without inertia not checked",
+        "The check for motions with neither inertia nor restraint (E0308) looks only at bodies \
+short of inertia (massless, or slender about an axis) that the joints do not hold one by one \
+from something with inertia or from the ground, and factors each group of them coupled to \
+each other densely. A group with more than 3,000 free motions (some 500 massless bodies joined \
+to each other, none held) would take minutes, so it is not checked and this warning says so. \
+If such a motion exists, the run stops at its first step with a singular iteration matrix \
+(E0602). Give the bodies mass and inertia, or hold them.";
     W0601 = "W0601", "initial velocities projected onto the constraints",
         "The initial velocities violate the joints' velocity constraints. They were projected onto \
 the constraints in the metric of the mass matrix, which is exactly the impulsive response of the \

@@ -277,11 +277,15 @@ fn unrestrained(model: &Model, r: &Rows, from: usize, inertia: usize, sink: &mut
     for (nodes, rows) in groups {
         // The group's columns in node order, so a null vector reads node by node.
         // A null vector moves each node within its free motions: `v_k = N_k z_k`.
-        let mut at = vec![usize::MAX; cols.nodes.len()];
+        let mut at = std::collections::HashMap::new();
         let mut width = 0;
         for &k in &nodes {
-            at[k] = width;
+            at.insert(k, width);
             width += basis[k].as_ref().map_or(0, |b| b.ncols());
+        }
+        if width > MAX_GROUP {
+            unchecked(model, cols.nodes[nodes[0]], nodes.len(), width, sink);
+            continue;
         }
         let mut a = DMatrix::<f64>::zeros(rows.len(), width);
         for (i, row) in rows.iter().enumerate() {
@@ -289,7 +293,7 @@ fn unrestrained(model: &Model, r: &Rows, from: usize, inertia: usize, sink: &mut
                 let k = node_of[c];
                 if let Some(b) = &basis[k] {
                     for q in 0..b.ncols() {
-                        a[(i, at[k] + q)] += v * b[(c - cols.start[k], q)];
+                        a[(i, at[&k] + q)] += v * b[(c - cols.start[k], q)];
                     }
                 }
             }
@@ -302,7 +306,7 @@ fn unrestrained(model: &Model, r: &Rows, from: usize, inertia: usize, sink: &mut
         let motion = |k: usize| -> Vec<f64> {
             let b = basis[k].as_ref().expect("a short node");
             (0..b.nrows())
-                .map(|i| (0..b.ncols()).map(|q| b[(i, q)] * z[at[k] + q]).sum())
+                .map(|i| (0..b.ncols()).map(|q| b[(i, q)] * z[at[&k] + q]).sum())
                 .collect()
         };
         // The node that moves most in this motion, and how.
@@ -320,6 +324,24 @@ fn unrestrained(model: &Model, r: &Rows, from: usize, inertia: usize, sink: &mut
         report(model, cols.nodes[k], t, rot, sink);
         return;
     }
+}
+
+/// Most free motions a group of bodies short of inertia may have for the dense check (a
+/// matrix of this order, seconds to factor).
+const MAX_GROUP: usize = 3000;
+
+/// W0302: a group of bodies short of inertia, coupled to each other but not held one by one,
+/// too large for the dense check.
+fn unchecked(model: &Model, first: Node, bodies: usize, width: usize, sink: &mut Sink) {
+    let (name, span) = match first {
+        Node::Body { body } => (model.bodies[body].name.clone(), model.bodies[body].span),
+        Node::BeamNode { beam, .. } => (model.beams[beam].name.clone(), model.beams[beam].span),
+    };
+    sink.push(
+        Diagnostic::warning(Code::W0302, format!("{bodies} bodies short of inertia, from `{name}` on, were not checked for motions without inertia or restraint ({width} free motions, over {MAX_GROUP})"))
+            .at(span, "the first of them")
+            .hint("give these bodies mass and inertia, or hold each by a joint to something that has; if a motion is free after all, the run stops with a singular iteration matrix (E0602) naming where"),
+    );
 }
 
 /// E0308 for a motion of `node`: its translation and rotation parts.
