@@ -138,6 +138,10 @@ pub fn compile_with(
 
 /// True if the text is a library of components rather than a model (no `model` header).
 pub fn is_library(text: &str) -> bool {
+    // Without the keyword there is no component: no need to parse the text twice.
+    if !text.contains("component") {
+        return false;
+    }
     match syntax::parse_file(text, source::SourceId(0)) {
         Ok(f) => {
             !f.items
