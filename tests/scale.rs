@@ -367,3 +367,30 @@ fn a_large_group_of_massless_bodies_is_reported_unchecked_not_hung() {
     };
     insta::assert_snapshot!("massless_unchecked", render_human(&d[1], &c.sources, false));
 }
+
+/// A chain of definitions declared last-first is evaluated one inside another, as deep as
+/// it is long: 10,000 deep compiles on a test thread's small stack (it grows on the heap),
+/// one more is refused with a code.
+#[test]
+fn a_chain_of_definitions_in_reverse_is_evaluated_to_the_limit_and_refused_past_it() {
+    let model = |n: usize| -> String {
+        let head = "model big\nground earth\npoint_mass bob { mass = 1 kg, at = (0, -1, 0) m }\n\
+                    joint rope = distance(earth, bob)\n";
+        let chain: String = (1..n)
+            .rev()
+            .map(|i| format!("param p{i} = {i} m + p{} * 0\n", i - 1))
+            .collect();
+        let tail = format!(
+            "param p0 = 0 m\ninitial velocity of bob = (p{} / 1 s, 0, 0)\n\
+             solve hht {{ dt = 1 ms, until = 1 s }}\n",
+            n - 1
+        );
+        format!("{head}{chain}{tail}")
+    };
+    let d = diagnostics(&model(10_000));
+    assert!(d.is_empty(), "{:?}", d.first());
+    let d = diagnostics(&model(10_001));
+    assert_eq!(d.len(), 1, "{:?}", d.first());
+    assert_eq!(d[0].code, Code::E0207);
+    assert_eq!(d[0].message, "definitions nest more than 10000 deep");
+}

@@ -183,6 +183,8 @@ pub struct Env {
     pub errors: Vec<Diagnostic>,
     /// Nesting of on-demand evaluations, to stop runaway self-reference.
     pub(super) depth: usize,
+    /// Nesting of binding evaluations (a chain of definitions), at most [`MAX_NESTED`].
+    pub(super) nested: usize,
     /// Set by [`Env::resolve_family`]: a family named without an index resolves to
     /// [`Ref::Family`] instead of asking for an index.
     pub(super) families: bool,
@@ -190,6 +192,10 @@ pub struct Env {
     /// through, each with the scope it is evaluated in.
     pub(super) offsets: Option<Vec<Offset>>,
 }
+
+/// The deepest chain of definitions evaluated one inside another (each level's stack grows
+/// on the heap as it needs).
+pub const MAX_NESTED: usize = 10_000;
 
 impl Env {
     pub fn new_scope(
@@ -425,9 +431,22 @@ impl Env {
         };
         self.bindings[id].state = State::InProgress;
         let scope = self.bindings[id].scope;
-        let result = self
-            .eval_in(scope, &expr)
-            .and_then(|v| self.check_binding(id, v, &expr));
+        // A definition that uses another evaluates it first: a chain of them declared in
+        // reverse is as deep as it is long. The stack grows on the heap as it needs, up to
+        // MAX_NESTED definitions.
+        self.nested += 1;
+        let value = if self.nested > MAX_NESTED {
+            Err(Diagnostic::error(
+                Code::E0207,
+                format!("definitions nest more than {MAX_NESTED} deep"),
+            )
+            .at(self.bindings[id].span, "the innermost")
+            .hint("a value uses one that uses another, and so on: shorten the chain, e.g. with a `for` loop or by writing values directly"))
+        } else {
+            stacker::maybe_grow(256 * 1024, 8 * 1024 * 1024, || self.eval_in(scope, &expr))
+        };
+        self.nested -= 1;
+        let result = value.and_then(|v| self.check_binding(id, v, &expr));
         match result {
             Ok(v) => {
                 self.bindings[id].state = State::Done(v.clone());
