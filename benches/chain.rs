@@ -23,8 +23,8 @@ fn runs(c: &mut Criterion) {
         .into_iter()
         .flat_map(|n| [(n, 1), (n, STEPS)])
     {
-        let source = chain(n, steps);
-        let compiled = match mbd::compile("chain.mbd", &source, &[], Request::default()) {
+        let (source, sets) = chain(n, steps);
+        let compiled = match mbd::compile("chain.mbd", &source, &sets, Request::default()) {
             Ok(c) => c,
             Err(f) => panic!("the {n}-link chain does not compile: {:?}", f.diagnostics),
         };

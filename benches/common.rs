@@ -8,23 +8,12 @@ pub fn model_text(file: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"))
 }
 
-/// The chain's text, `n` links of 0.1 m and 0.1 kg.
+/// `models/chain.mbd` and the `--set`s that make it `n` links of 0.1 m and 0.1 kg, run for
+/// `steps` steps of 1 ms.
 #[allow(dead_code)]
-pub fn chain(n: usize, steps: usize) -> String {
-    format!(
-        "model chain \"{n} rods on revolute hinges\"
-param l = 0.1 m
-gravity = (0, -9.81, 0) m/s^2
-ground earth
-for i in 1..={n} {{
-    rigid_rod rod[i] {{ from = ((i - 1) * l, 0, 0), to = (i * l, 0, 0), mass = 0.1 kg }}
-}}
-joint pin = revolute(earth, rod[1].start) {{ axis = z }}
-for i in 1..{n} {{
-    joint hinge[i] = revolute(rod[i].end, rod[i + 1].start) {{ axis = z }}
-}}
-output tip_y = rod[{n}].end.position.y
-solve hht(alpha = -0.1) {{ dt = 1 ms, until = {steps} ms }}
-"
+pub fn chain(n: usize, steps: usize) -> (String, Vec<String>) {
+    (
+        model_text("chain.mbd"),
+        vec![format!("links={n}"), format!("steps={steps}")],
     )
 }

@@ -28,10 +28,10 @@ fn sizes(c: &mut Criterion) {
     let mut group = c.benchmark_group("check chain");
     group.sample_size(10);
     for n in [10, 100, 1000, 10000] {
-        let text = common::chain(n, 10);
-        assert!(mbd::compile("chain.mbd", &text, &[], Request::default()).is_ok());
+        let (text, sets) = common::chain(n, 10);
+        assert!(mbd::compile("chain.mbd", &text, &sets, Request::default()).is_ok());
         group.bench_function(format!("{n} links"), |b| {
-            b.iter(|| mbd::compile("chain.mbd", &text, &[], Request::default()).is_ok())
+            b.iter(|| mbd::compile("chain.mbd", &text, &sets, Request::default()).is_ok())
         });
     }
     group.finish();

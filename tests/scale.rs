@@ -7,29 +7,15 @@ use crate::common::repo;
 use mbd::diagnostics::{render_human, summarize, Code, Diagnostic};
 use mbd::settings::Request;
 
-/// A planar chain of `n` rods hinged end to end, pinned to the ground at its start, and
-/// `extra` declarations.
-fn chain(n: usize, extra: &str) -> String {
-    format!(
-        "model chain
-param l = 0.1 m
-gravity = (0, -9.81, 0) m/s^2
-ground earth
-for i in 1..={n} {{
-    rigid_rod rod[i] {{ from = ((i - 1) * l, 0, 0), to = (i * l, 0, 0), mass = 0.1 kg }}
-}}
-joint pin = revolute(earth, rod[1].start) {{ axis = z }}
-for i in 1..{n} {{
-    joint hinge[i] = revolute(rod[i].end, rod[i + 1].start) {{ axis = z }}
-}}
-{extra}
-solve hht {{ dt = 1 ms, until = 10 ms }}
-"
-    )
+/// `models/chain.mbd` (a planar chain of rods hinged end to end, pinned to the ground at its
+/// start) at `n` links, with `extra` declarations.
+fn chain(n: usize, extra: &str) -> (String, Vec<String>) {
+    let text = crate::common::read("models/chain.mbd");
+    (format!("{text}{extra}\n"), vec![format!("links={n}")])
 }
 
-fn diagnostics(text: &str) -> Vec<Diagnostic> {
-    match mbd::compile("chain.mbd", text, &[], Request::default()) {
+fn diagnostics((text, sets): &(String, Vec<String>)) -> Vec<Diagnostic> {
+    match mbd::compile("chain.mbd", text, sets, Request::default()) {
         Ok(c) => c.warnings,
         Err(f) => f.diagnostics,
     }
@@ -113,14 +99,14 @@ fn large_loops_reduced_on_a_tree_agree_with_the_dense_check() {
         ("revolute", true, 3),
     ] {
         for n in [90, 110] {
-            let mut text = chain(n, &closing(n, kind));
+            let mut model = chain(n, &closing(n, kind));
             if bent {
-                text = text.replace(
+                model.0 = model.0.replace(
                     "from = ((i - 1) * l, 0, 0), to = (i * l, 0, 0)",
                     &format!("from = ((i - 1) * l, 0.01 * (i - 1) * ({n} - i + 1) * l, 0), to = (i * l, 0.01 * i * ({n} - i) * l, 0)"),
                 );
             }
-            let d = diagnostics(&text);
+            let d = diagnostics(&model);
             assert_eq!(d.len(), 1, "{kind} {n}: {:?}", d);
             assert_eq!(d[0].code, Code::E0307);
             let tail = format!("({too_many} equations too many)");
@@ -160,7 +146,7 @@ fn many_diagnostics_are_summarised_per_code_and_all_listed_in_json() {
             "solve hht { dt = 1 ms, until = 1 s }\n".into(),
         ))
         .collect();
-    let d = diagnostics(&text);
+    let d = diagnostics(&(text.clone(), Vec::new()));
     assert_eq!(d.len(), n);
     let (shown, more) = summarize(&d, 10);
     assert_eq!(shown.len(), 10);
@@ -211,11 +197,11 @@ fn long_operator_chains_compile_up_to_the_limit_and_are_refused_past_it() {
         ]
     };
     for value in chains(1000) {
-        let d = diagnostics(&model(&value));
+        let d = diagnostics(&(model(&value), Vec::new()));
         assert!(d.iter().all(|d| d.code.is_warning()), "{:?}", d.first());
     }
     for value in chains(1001) {
-        let d = diagnostics(&model(&value));
+        let d = diagnostics(&(model(&value), Vec::new()));
         assert_eq!(d.len(), 1);
         assert_eq!(d[0].code, Code::E0101);
         assert_eq!(
@@ -354,11 +340,11 @@ fn a_large_group_of_massless_bodies_is_reported_unchecked_not_hung() {
              solve hht {{ dt = 1 ms, until = 1 s }}\n"
         )
     };
-    let d = diagnostics(&floating(100));
+    let d = diagnostics(&(floating(100), Vec::new()));
     let codes: Vec<Code> = d.iter().map(|d| d.code).collect();
     assert_eq!(codes, [Code::W0301, Code::E0308], "{d:?}");
     let text = floating(600);
-    let d = diagnostics(&text);
+    let d = diagnostics(&(text.clone(), Vec::new()));
     let codes: Vec<Code> = d.iter().map(|d| d.code).collect();
     assert_eq!(codes, [Code::W0301, Code::W0302], "{d:?}");
     let c = match mbd::compile("m.mbd", &text, &[], Request::default()) {
@@ -387,9 +373,9 @@ fn a_chain_of_definitions_in_reverse_is_evaluated_to_the_limit_and_refused_past_
         );
         format!("{head}{chain}{tail}")
     };
-    let d = diagnostics(&model(10_000));
+    let d = diagnostics(&(model(10_000), Vec::new()));
     assert!(d.is_empty(), "{:?}", d.first());
-    let d = diagnostics(&model(10_001));
+    let d = diagnostics(&(model(10_001), Vec::new()));
     assert_eq!(d.len(), 1, "{:?}", d.first());
     assert_eq!(d[0].code, Code::E0207);
     assert_eq!(d[0].message, "definitions nest more than 10000 deep");

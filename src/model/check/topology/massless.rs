@@ -333,15 +333,20 @@ const MAX_GROUP: usize = 3000;
 /// W0302: a group of bodies short of inertia, coupled to each other but not held one by one,
 /// too large for the dense check.
 fn unchecked(model: &Model, first: Node, bodies: usize, width: usize, sink: &mut Sink) {
-    let (name, span) = match first {
-        Node::Body { body } => (model.bodies[body].name.clone(), model.bodies[body].span),
-        Node::BeamNode { beam, .. } => (model.beams[beam].name.clone(), model.beams[beam].span),
-    };
+    let (name, span) = named(model, first);
     sink.push(
         Diagnostic::warning(Code::W0302, format!("{bodies} bodies short of inertia, from `{name}` on, were not checked for motions without inertia or restraint ({width} free motions, over {MAX_GROUP})"))
             .at(span, "the first of them")
             .hint("give these bodies mass and inertia, or hold each by a joint to something that has; if a motion is free after all, the run stops with a singular iteration matrix (E0602) naming where"),
     );
+}
+
+/// The body or beam a node belongs to: its name and declaration.
+fn named(model: &Model, node: Node) -> (String, crate::source::Span) {
+    match node {
+        Node::Body { body } => (model.bodies[body].name.clone(), model.bodies[body].span),
+        Node::BeamNode { beam, .. } => (model.beams[beam].name.clone(), model.beams[beam].span),
+    }
 }
 
 /// E0308 for a motion of `node`: its translation and rotation parts.
@@ -360,10 +365,7 @@ fn report(model: &Model, node: Node, t: [f64; 3], rot: [f64; 3], sink: &mut Sink
     } else {
         format!("translation along {}", describe(t))
     };
-    let (name, span) = match node {
-        Node::Body { body } => (model.bodies[body].name.clone(), model.bodies[body].span),
-        Node::BeamNode { beam, .. } => (model.beams[beam].name.clone(), model.beams[beam].span),
-    };
+    let (name, span) = named(model, node);
     sink.push(
         Diagnostic::error(Code::E0308, format!("`{name}` can move without inertia or restraint: {motion}"))
             .at(span, "declared here")
