@@ -30,6 +30,7 @@ fn runs(c: &mut Criterion) {
     }
     for method in [Method::Floquet, Method::Prony] {
         let spec = SweepSpec {
+            monodromy: mbd::solve::floquet::Monodromy::Tangent,
             param: "Omega_bar".to_string(),
             values: vec![1.5],
             methods: vec![method],

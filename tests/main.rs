@@ -10,6 +10,7 @@ mod diagnostics;
 mod docs;
 mod emit;
 mod fet;
+mod floquet;
 mod friction;
 mod grammar;
 mod joints;

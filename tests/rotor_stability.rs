@@ -12,6 +12,7 @@ const OMEGA_T: f64 = 9.26;
 
 fn spec(values: Vec<f64>, methods: Vec<Method>, refine: usize) -> SweepSpec {
     SweepSpec {
+        monodromy: mbd::solve::floquet::Monodromy::Tangent,
         param: "Omega_bar".to_string(),
         values,
         methods,

@@ -6,6 +6,7 @@ use super::progress::Evaluations;
 use super::swept::Swept;
 use super::{create_outputs, draw, exit_unless_failed, read, say, short, usage, Format, Jobs};
 use mbd::output::charts::Series;
+use mbd::solve::floquet::Monodromy;
 use mbd::study::sweep::{self, Method, SweepSpec};
 use mbd::Compiled;
 use std::process::ExitCode;
@@ -15,10 +16,13 @@ pub const LONG_ABOUT: &str = "\
 Stability sweep: for each value of a param, the characteristic exponents s of the model's \
 motion, and the edges of the unstable ranges.
 
-Floquet (--method floquet, the default): the monodromy matrix of the motion over one period T \
-(2 pi / Omega of the joint driven at a constant speed, or --period), built from perturbed \
-integrations in the constraint-free subspace with the model's integrator and step (THEORY \
-§9.2): 4 n_f + 1 runs of one period, n_f the free coordinates. Exponents s = (ln|Lambda| + \
+Floquet (--method floquet, the default): the monodromy matrix of the discrete motion over one \
+period T (2 pi / Omega of the joint driven at a constant speed, or --period) with the model's \
+integrator and step, in the constraint-free subspace (THEORY §9.2): by default from the step's \
+own tangent, 2 n_f directions of the state carried through one run of the period by the \
+converged steps' iteration matrices (the HHT and generalized-alpha integrators with \
+incremental rotations; --monodromy runs, time finite elements and conformal rotations build \
+it from 4 n_f + 1 perturbed runs of one period), n_f the free coordinates. Exponents s = (ln|Lambda| + \
 i arg Lambda) / T; the frequency is known only modulo 2 pi / T and is reported on the \
 principal branch, |Im s| <= pi / T.
 
@@ -59,6 +63,10 @@ pub struct StabilityArgs {
     /// Floquet: the period in seconds (default: 2 pi / Omega of the driven rotor).
     #[arg(long)]
     period: Option<f64>,
+    /// Floquet: the monodromy from the step's own tangent along one run, or from perturbed
+    /// runs (4 n_f + 1 runs of a period; the cross-check).
+    #[arg(long, value_enum, default_value = "tangent")]
+    monodromy: MonodromyArg,
     /// Prony: the channels to fit (comma-separated; default: every output channel).
     #[arg(long, value_name = "LIST")]
     signals: Option<String>,
@@ -86,6 +94,12 @@ pub struct StabilityArgs {
     /// Write the chart here (PNG for a `.png` name, else SVG).
     #[arg(long, value_name = "STAB.svg")]
     chart: Option<String>,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum MonodromyArg {
+    Tangent,
+    Runs,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -129,6 +143,10 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         values: swept.values,
         methods,
         period: a.period,
+        monodromy: match a.monodromy {
+            MonodromyArg::Tangent => Monodromy::Tangent,
+            MonodromyArg::Runs => Monodromy::Runs,
+        },
         signals,
         window,
         samples: a.samples,

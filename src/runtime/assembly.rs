@@ -110,14 +110,12 @@ impl Assembler {
         }
     }
 
-    /// The elements whose tangent depends on the rates of frames (`System::is_frame`), with
-    /// each frame's unknowns in local positions (a frame counts only with all six).
+    /// The elements whose tangent depends on the rates of rotating nodes, with each node's
+    /// unknowns in local positions (a node counts only with all six).
     fn rated(sys: &System, indices: &[Vec<usize>]) -> Rated {
         let mut frame_at = vec![None; sys.len()];
         for (k, &r) in sys.rotations.iter().enumerate() {
-            if sys.is_frame(k) {
-                frame_at[r] = Some(k);
-            }
+            frame_at[r] = Some(k);
         }
         let mut out = Vec::new();
         for (e, (el, idx)) in sys.elements.iter().zip(indices).enumerate() {
@@ -155,6 +153,7 @@ impl Assembler {
         aug: Augment,
         force_weight: f64,
         maps: &[([f64; 36], [f64; 36])],
+        frames_only: bool,
     ) {
         let rates = |mass: f64, velocity: f64| TangentCoeffs {
             mass,
@@ -162,13 +161,17 @@ impl Assembler {
             position: 0.0,
             force_weight,
         };
+        let take = |k: usize| !frames_only || sys.is_frame(k);
         for (e, nodes) in &self.rated {
+            if !nodes.iter().any(|&(k, _)| take(k)) {
+                continue;
+            }
             let (el, map) = (&sys.elements[*e], &self.maps[*e]);
             let nl2 = map.len();
             let nl = self.indices[*e].len();
             el.tangent(st, aug, rates(1.0, 0.0), &mut self.local[..nl2]);
             el.tangent(st, aug, rates(0.0, 1.0), &mut self.local2[..nl2]);
-            for (k, at) in nodes {
+            for (k, at) in nodes.iter().filter(|&&(k, _)| take(k)) {
                 let (ev, ea) = &maps[*k];
                 for i in 0..nl {
                     let (m, c) = (&self.local[i * nl..], &self.local2[i * nl..]);

@@ -1,5 +1,6 @@
 //! Floquet analysis with the time integrator (THEORY §9.2): the monodromy matrix of the motion
-//! over one period, built from perturbed integrations in the constraint-free subspace.
+//! over one period, of the discrete map of the model's own integrator and step, in the
+//! constraint-free subspace.
 //!
 //! 1. The reference run starts from the model's initial state, made consistent (positions,
 //!    velocities, then accelerations and multipliers: a consistent start whatever the model's
@@ -10,16 +11,28 @@
 //!    length scale and rotations in radians. States are `z = (N0^T W^-1 dq, N0^T W^-1 dv / w)`
 //!    with `w = 2 pi / T`, of dimension `2 n_f`; rotations differ by
 //!    `axial log(R Rbar^T)` (spatial, as the perturbation `R <- exp(dtheta~) R`).
-//! 3. Each state direction is perturbed by `+-eps`, the perturbed state is made consistent the
-//!    same way as the reference (positions projected back onto the joints, velocities made
-//!    tangent: this moves the velocities that depend on a position perturbation), and
-//!    integrated over one period with the production integrator and step (rounded so that a
-//!    whole number of steps fills the period). With `Z_0` and `Z_T` the central differences
-//!    `(z+ - z-) / 2 eps` at the start (after the projection) and after one period,
-//!    `Phi = Z_T Z_0^-1`.
-//! 4. The eigenvalues of `Phi` are the characteristic multipliers `Lambda`; the exponents are
+//! 3. Each state direction is perturbed by `+-eps` and made consistent the same way as the
+//!    reference (positions projected back onto the joints, velocities made tangent, consistent
+//!    accelerations): `Z_0`, the central differences of their measure.
+//! 4. [`Monodromy::Tangent`] (the default): the same starts' differences in the integrator's
+//!    whole step state `(q, v, a, A)` (`A` the algorithmic accelerations; frames as body-frame
+//!    increments and twists) are the directions `S_0`, carried through one run of the period by
+//!    each converged step's own tangent (`integrator/tangent.rs`: `S_{n+1} = T S_n + D x`,
+//!    `J x = -dr/ds S_n` with the exact iteration matrix `J` factored at the converged step);
+//!    `Z_T` is their measure at the end. [`Monodromy::Runs`]: each perturbed start integrated
+//!    over the period, `Z_T` the central differences of the ends. `Phi = Z_T Z_0^-1`.
+//! 5. The eigenvalues of `Phi` are the characteristic multipliers `Lambda`; the exponents are
 //!    `s = (ln|Lambda| + i arg Lambda) / T`, frequencies on the principal branch
 //!    `|Im s| <= pi / T` (known only modulo `2 pi / T`).
+//!
+//! The step's own state: HHT and generalized-alpha carry `a` and `A`, so the discrete map
+//! lives in `(q, v, a, A)`, twice the dimension of `z`. Both monodromies chain the
+//! sensitivities through the consistent start (accelerations as functions of `(q, v)` at
+//! `t = 0`) and carry the whole step state inside the period, measuring `(q, v)` at its end.
+//! The discrete map's extra multipliers are algorithmic: an HHT or generalized-alpha step
+//! damps them by `rho_inf` (0.82 at alpha -0.1), so over the `N` steps of a period (hundreds)
+//! their share of `Z_T` is `rho_inf^N` (1e-79 on the windmill): `Phi` is the physical block of
+//! the discrete monodromy to that order, and no algorithmic multiplier needs separating.
 //!
 //! The reference is the model's own motion from its initial state, loads included: a pulse that
 //! acts in the first period is in every run and cancels in the differences (to first order
@@ -57,6 +70,8 @@ pub struct Floquet {
     pub exponents: Vec<c64>,
     /// Newton iterations over all runs.
     pub newton_iterations: usize,
+    /// How the monodromy matrix was built.
+    pub how: Monodromy,
 }
 
 /// Where a Floquet analysis failed: a run and the integrator's failure.
@@ -180,12 +195,71 @@ fn integrate(it: &mut Integrator) -> Result<State, RuntimeFailure> {
     Ok(it.state().clone())
 }
 
+/// How the monodromy matrix is built.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Monodromy {
+    /// From the step's own tangent carried along one run (the Newmark family with
+    /// incremental rotations; other integrators fall back to [`Monodromy::Runs`]).
+    Tangent,
+    /// From `4 n_f` perturbed runs of one period, by central differences (any integrator).
+    Runs,
+}
+
+/// What the start of a Floquet analysis leaves: the integrator at the consistent reference
+/// start, and the perturbation space.
+struct Space {
+    free: Vec<usize>,
+    weights: Vec<f64>,
+    basis: Vec<f64>,
+    r: usize,
+    omega: f64,
+    start: State,
+}
+
+impl Space {
+    fn measure(&self, sys: &System, st: &State, reference: &State) -> Vec<f64> {
+        measure(
+            sys,
+            st,
+            reference,
+            &self.free,
+            &self.basis,
+            &self.weights,
+            self.omega,
+        )
+    }
+
+    fn perturbed(&self, sys: &System, dir: usize, eps: f64) -> State {
+        perturbed(
+            sys,
+            &self.free,
+            &self.basis,
+            &self.weights,
+            self.omega,
+            dir,
+            eps,
+        )
+    }
+}
+
 /// Floquet analysis of the model's motion over `period` seconds (THEORY §9.2), with the
-/// integrator and step of `set`. `progress` is called after each integration.
+/// integrator and step of `set`, the monodromy from the step's tangent where the integrator
+/// carries one. `progress` is called after each integration.
 pub fn floquet(
     sys: &System,
     set: &Settings,
     period: f64,
+    progress: &dyn Fn(),
+) -> Result<Floquet, FloquetFailure> {
+    floquet_by(sys, set, period, Monodromy::Tangent, progress)
+}
+
+/// [`floquet`] with the monodromy built as `how` says.
+pub fn floquet_by(
+    sys: &System,
+    set: &Settings,
+    period: f64,
+    how: Monodromy,
     progress: &dyn Fn(),
 ) -> Result<Floquet, FloquetFailure> {
     let reference_failure = |failure| FloquetFailure { run: None, failure };
@@ -194,47 +268,22 @@ pub fn floquet(
     let mut it = Integrator::new(sys, &set).map_err(reference_failure)?;
     it.initialize().map_err(reference_failure)?;
     let lin = it.linearize();
-    let free = lin.unknowns.clone();
     let (weights, basis, r) = perturbation_space(sys, &lin).map_err(reference_failure)?;
-    let omega = 2.0 * std::f64::consts::PI / period;
-    let start_reference = it.state().clone();
-    let reference = integrate(&mut it).map_err(reference_failure)?;
-    progress();
-    let mut newton_iterations = it.stats().newton_iterations;
+    let space = Space {
+        free: lin.unknowns.clone(),
+        weights,
+        basis,
+        r,
+        omega: 2.0 * std::f64::consts::PI / period,
+        start: it.state().clone(),
+    };
+    let how = if it.can_track() { how } else { Monodromy::Runs };
+    let (z0, zt, newton_iterations) = match how {
+        Monodromy::Tangent => by_tangent(sys, &mut it, &space, progress)?,
+        Monodromy::Runs => by_runs(sys, &mut it, &space, progress)?,
+    };
     let n = 2 * r;
-    // Columns of the perturbations at the start (after the projection onto the joints, which
-    // moves the dependent velocities of a position perturbation) and after one period:
-    // Phi = Z_T Z_0^-1.
-    let mut z0 = DMatrix::<f64>::zeros(n, n);
-    let mut zt = DMatrix::<f64>::zeros(n, n);
-    for dir in 0..n {
-        for sign in [1.0, -1.0] {
-            let fail = |failure| FloquetFailure {
-                run: Some((dir, sign)),
-                failure,
-            };
-            let start = perturbed(sys, &free, &basis, &weights, omega, dir, sign * EPSILON);
-            it.restart(&start).map_err(fail)?;
-            let a = measure(
-                sys,
-                it.state(),
-                &start_reference,
-                &free,
-                &basis,
-                &weights,
-                omega,
-            );
-            let end = integrate(&mut it).map_err(fail)?;
-            newton_iterations += it.stats().newton_iterations;
-            let b = measure(sys, &end, &reference, &free, &basis, &weights, omega);
-            for i in 0..n {
-                z0[(i, dir)] += sign * a[i] / (2.0 * EPSILON);
-                zt[(i, dir)] += sign * b[i] / (2.0 * EPSILON);
-            }
-            progress();
-        }
-    }
-    let phi_m = match z0.clone().lu().solve(&DMatrix::<f64>::identity(n, n)) {
+    let phi_m = match z0.lu().solve(&DMatrix::<f64>::identity(n, n)) {
         Some(inv) => &zt * inv,
         None => {
             return Err(reference_failure(RuntimeFailure {
@@ -267,7 +316,124 @@ pub fn floquet(
         multipliers,
         exponents,
         newton_iterations,
+        how,
     })
+}
+
+/// The columns of the perturbations at the start and after one period, and the Newton
+/// iterations they took.
+type Columns = (DMatrix<f64>, DMatrix<f64>, usize);
+
+/// The perturbed starts, each made consistent: their measure `Z_0` (central differences);
+/// `each(it, dir, sign)` is called with the integrator at each start.
+fn starts<F>(
+    sys: &System,
+    it: &mut Integrator,
+    space: &Space,
+    mut each: F,
+) -> Result<DMatrix<f64>, FloquetFailure>
+where
+    F: FnMut(&mut Integrator, usize, f64) -> Result<(), RuntimeFailure>,
+{
+    let n = 2 * space.r;
+    let mut z0 = DMatrix::<f64>::zeros(n, n);
+    for dir in 0..n {
+        for sign in [1.0, -1.0] {
+            let fail = |failure| FloquetFailure {
+                run: Some((dir, sign)),
+                failure,
+            };
+            it.restart(&space.perturbed(sys, dir, sign * EPSILON))
+                .map_err(fail)?;
+            let a = space.measure(sys, it.state(), &space.start);
+            for i in 0..n {
+                z0[(i, dir)] += sign * a[i] / (2.0 * EPSILON);
+            }
+            each(it, dir, sign).map_err(fail)?;
+        }
+    }
+    Ok(z0)
+}
+
+/// The monodromy's columns from the step's tangent: the perturbed starts' directions carried
+/// through one run of the period (THEORY §9.2), measured at its end.
+fn by_tangent(
+    sys: &System,
+    it: &mut Integrator,
+    space: &Space,
+    progress: &dyn Fn(),
+) -> Result<Columns, FloquetFailure> {
+    let reference_failure = |failure| FloquetFailure { run: None, failure };
+    let n = 2 * space.r;
+    let dim = it.direction_len();
+    let mut directions = vec![0.0; n * dim];
+    let mut diff = vec![0.0; dim];
+    // Each start's difference from the reference start in the step's state layout.
+    let z0 = starts(sys, it, space, |it, dir, sign| {
+        it.state_difference(it.state(), &space.start, &mut diff);
+        let col = &mut directions[dir * dim..(dir + 1) * dim];
+        for (c, d) in col.iter_mut().zip(&diff) {
+            *c += sign * d / (2.0 * EPSILON);
+        }
+        Ok(())
+    })?;
+    it.restart(&sys.initial).map_err(reference_failure)?;
+    it.track(directions, 1.0 / space.omega);
+    let reference = integrate(it).map_err(reference_failure)?;
+    progress();
+    let carried = it.tracked().unwrap_or_default();
+    let mut zt = DMatrix::<f64>::zeros(n, n);
+    let mut st = reference.clone();
+    for dir in 0..n {
+        let col = &carried[dir * dim..(dir + 1) * dim];
+        // The measure reads positions and rates; it is linear but for the rotations'
+        // logarithm: a small step of each sign, sized by them (a stiff mode's accelerations
+        // would shrink it into round-off).
+        let size = col[..dim / 2].iter().enumerate().fold(0.0f64, |m, (i, x)| {
+            let scale = if i < dim / 4 { 1.0 } else { 1.0 / space.omega };
+            m.max(x.abs() * scale / sys.length_scale.min(1.0))
+        });
+        if size == 0.0 {
+            continue;
+        }
+        let e = 1e-6 / size;
+        it.perturb_state(&reference, col, e, &mut st);
+        let b = space.measure(sys, &st, &reference);
+        it.perturb_state(&reference, col, -e, &mut st);
+        let c = space.measure(sys, &st, &reference);
+        for i in 0..n {
+            zt[(i, dir)] = (b[i] - c[i]) / (2.0 * e);
+        }
+    }
+    Ok((z0, zt, it.stats().newton_iterations))
+}
+
+/// The monodromy's columns from `4 n_f` perturbed runs of one period.
+fn by_runs(
+    sys: &System,
+    it: &mut Integrator,
+    space: &Space,
+    progress: &dyn Fn(),
+) -> Result<Columns, FloquetFailure> {
+    let reference_failure = |failure| FloquetFailure { run: None, failure };
+    let reference = integrate(it).map_err(reference_failure)?;
+    progress();
+    let mut newton_iterations = it.stats().newton_iterations;
+    let n = 2 * space.r;
+    // Each perturbed start integrated over the period (the projection onto the joints at the
+    // start moves the dependent velocities of a position perturbation): Phi = Z_T Z_0^-1.
+    let mut zt = DMatrix::<f64>::zeros(n, n);
+    let z0 = starts(sys, it, space, |it, dir, sign| {
+        let end = integrate(it)?;
+        newton_iterations += it.stats().newton_iterations;
+        let b = space.measure(sys, &end, &reference);
+        for i in 0..n {
+            zt[(i, dir)] += sign * b[i] / (2.0 * EPSILON);
+        }
+        progress();
+        Ok(())
+    })?;
+    Ok((z0, zt, newton_iterations))
 }
 
 /// The weighted perturbation space: the weights of the free coordinates (translations in

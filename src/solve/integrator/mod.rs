@@ -20,6 +20,7 @@ mod start;
 mod start_matrix;
 mod statics;
 mod step;
+mod tangent;
 #[cfg(test)]
 mod tests;
 
@@ -122,6 +123,10 @@ pub struct Integrator<'s> {
     /// its 50 s depends on the iteration path (with the matrix kept it fails at 17 s, as
     /// without it at alpha -0.09 or -0.12).
     rigid: bool,
+    /// Beam nodes' columns exact too (their rates' dependence on the correction,
+    /// [`se3::rate_maps`]): for the step's tangent. Newton leaves them out (a linear
+    /// contraction on beam models, measured to keep the stiff-beam two-bar on its motion).
+    exact_rates: bool,
     /// The converged state at the current time.
     cur: State,
     /// The iterate of the step being solved.
@@ -140,6 +145,9 @@ pub struct Integrator<'s> {
     /// The constrained mass matrix of the start: plain, or with the stiffness on the massless
     /// motions that no joint holds ([`start_matrix`]).
     start: StartMetric,
+    /// Directions of the state carried through every step by the step's tangent
+    /// ([`tangent`]: Floquet's monodromy).
+    tracked: Option<Box<tangent::Tracked>>,
 }
 
 /// Why a step attempt failed, before it is turned into a [`RuntimeFailure`].
@@ -216,6 +224,7 @@ impl<'s> Integrator<'s> {
             predicted: vec![[0.0; 6]; nodes],
             far: false,
             rigid: (0..nodes).all(|k| sys.is_frame(k)),
+            exact_rates: false,
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
             rhs: vec![0.0; n],
@@ -228,6 +237,7 @@ impl<'s> Integrator<'s> {
             stats: RunStats::default(),
             step_index: 0,
             start: StartMetric::default(),
+            tracked: None,
         };
         it.aug = it.scaling(set.dt);
         Ok(it)
@@ -349,7 +359,7 @@ impl<'s> Integrator<'s> {
 
     fn advance(&mut self, h: f64, depth: usize) -> Result<(), StepFailure> {
         match self.attempt(h) {
-            Ok(()) => Ok(()),
+            Ok(()) => self.propagate(h),
             Err(f) if depth >= self.set.max_halvings => Err(f),
             Err(_) => {
                 self.stats.halvings += 1;

@@ -67,6 +67,24 @@ impl Scheme {
         }
     }
 
+    /// The Newmark relations of a step of `h`: (increment, previous rate, previous
+    /// acceleration, previous algorithmic acceleration) -> (rate, acceleration, algorithmic
+    /// acceleration). Linear in all four.
+    pub(super) fn relation(&self, h: f64, dq: f64, v: f64, a: f64, alg0: f64) -> (f64, f64, f64) {
+        let Scheme {
+            am,
+            af,
+            beta,
+            gamma,
+        } = *self;
+        let alg = (dq - h * v - h * h * (0.5 - beta) * alg0) / (beta * h * h);
+        (
+            v + h * ((1.0 - gamma) * alg0 + gamma * alg),
+            ((1.0 - am) * alg + am * alg0 - af * a) / (1.0 - af),
+            alg,
+        )
+    }
+
     /// `d a_{n+1} / d q_{n+1}`.
     fn mass_coefficient(&self, h: f64) -> f64 {
         (1.0 - self.am) / ((1.0 - self.af) * self.beta * h * h)
@@ -203,8 +221,9 @@ impl Integrator<'_> {
         // SE(3) frames: the Newmark relations act on body-frame twists, so the inertial
         // terms' columns take how those move with a correction (`se3::rate_maps`).
         if self.layout == Layout::Increments && self.method != Method::Static {
+            let all = self.exact_rates;
             for k in 0..self.sys.rotations.len() {
-                if self.sys.is_frame(k) {
+                if all || self.sys.is_frame(k) {
                     self.rate_maps[k] = se3::rate_maps(
                         self.sys,
                         &self.trial,
@@ -216,7 +235,7 @@ impl Integrator<'_> {
                 }
             }
             self.asm
-                .add_rate_columns(self.sys, &self.trial, aug, 1.0, &self.rate_maps);
+                .add_rate_columns(self.sys, &self.trial, aug, 1.0, &self.rate_maps, !all);
         }
         self.transform.apply(
             &self.asm.pattern,
@@ -319,28 +338,13 @@ impl Integrator<'_> {
     }
 
     /// Updates velocities and accelerations of the iterate from its positions (Newmark).
-    fn newmark(&mut self, h: f64) {
+    pub(super) fn newmark(&mut self, h: f64) {
         if self.method == Method::Static {
             self.static_rates();
             return;
         }
-        let Scheme {
-            am,
-            af,
-            beta,
-            gamma,
-            ..
-        } = self.sc;
-        // (increment, previous rate, previous acceleration, previous algorithmic acceleration)
-        // -> (rate, acceleration, algorithmic acceleration).
-        let relation = |dq: f64, v: f64, a: f64, alg0: f64| {
-            let alg = (dq - h * v - h * h * (0.5 - beta) * alg0) / (beta * h * h);
-            (
-                v + h * ((1.0 - gamma) * alg0 + gamma * alg),
-                ((1.0 - am) * alg + am * alg0 - af * a) / (1.0 - af),
-                alg,
-            )
-        };
+        let (sc, h) = (self.sc, h);
+        let relation = |dq: f64, v: f64, a: f64, alg0: f64| sc.relation(h, dq, v, a, alg0);
         let (cur, tr) = (&self.cur, &mut self.trial);
         for i in 0..self.sys.len() {
             if self.in_frame[i] || self.sys.unknowns[i].is_multiplier() {

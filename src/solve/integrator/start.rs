@@ -115,6 +115,7 @@ impl Integrator<'_> {
         self.cur.clone_from(initial);
         self.trial.clone_from(initial);
         self.mid.clone_from(initial);
+        self.tracked = None;
         self.stats = RunStats::default();
         self.step_index = 0;
         self.aug = self.scaling(self.set.dt);

@@ -18,6 +18,7 @@ pub use range::{grid, parse_range, split_range, RangeError, MAX_POINTS};
 
 use super::{cell, parallel};
 use crate::output::charts::{Chart, Series};
+use crate::solve::floquet::Monodromy;
 use crate::solve::modes::c64;
 use crate::Compiled;
 use point::evaluate;
@@ -53,6 +54,8 @@ pub struct SweepSpec {
     pub methods: Vec<Method>,
     /// Floquet's period (s); `None`: `2 pi / Omega` of the model's prescribed rotor speed.
     pub period: Option<f64>,
+    /// Floquet: how the monodromy matrix is built.
+    pub monodromy: Monodromy,
     /// Prony: the channels fitted (empty: [`default_signals`]).
     pub signals: Vec<String>,
     /// Prony: the part of the run fitted (s); `None`: from a tenth of the run to its end.

@@ -251,14 +251,16 @@ fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Found {
         Some(t) => t,
         None => rotor_period(c).map_err(PointError::Period)?,
     };
-    let f = floquet::floquet(&l.system, &c.settings, period, &|| {}).map_err(|f| {
-        let d = c.failure_diagnostic(&f.failure);
-        PointError::Floquet {
-            code: d.code,
-            message: d.message,
-            run: f.which(),
-        }
-    })?;
+    let f = floquet::floquet_by(&l.system, &c.settings, period, spec.monodromy, &|| {}).map_err(
+        |f| {
+            let d = c.failure_diagnostic(&f.failure);
+            PointError::Floquet {
+                code: d.code,
+                message: d.message,
+                run: f.which(),
+            }
+        },
+    )?;
     Ok((
         modes_of(&f.exponents),
         format!(

@@ -1,0 +1,374 @@
+//! The step's own tangent (THEORY §9.2, the monodromy by the implicit function theorem): how
+//! the state a converged step ends in moves with the state it started from, carried along a
+//! run for a set of directions (the columns of `S_n = d s_n / d z_0`).
+//!
+//! The step's state `s` is what the next step reads: positions, and for every coordinate
+//! its rate, acceleration and algorithmic acceleration (`v, a, A`); the SE(3) frames' body
+//! twists in their place. A direction is a flat vector of `4 n` entries: `[position, v, a,
+//! A]`, each indexed by unknown; a frame's translation and rotation slots hold its body-frame
+//! increment `H <- H exp(d)` and its twists' components, a beam node's rotation slots its
+//! body-frame rotation; multiplier slots stay zero (the converged step does not depend on the
+//! multipliers it started from: they are unknowns of the step).
+//!
+//! A step solves `r(x; s_n) = 0` for its increment and multipliers `x`, and
+//! `s_{n+1} = f(x; s_n)` (the Newmark relations and `H_{n+1} = H_n exp(x)`). With the
+//! iteration matrix `J = dr/dx` factored at the converged `x`,
+//! `dx = -J^-1 (dr/ds_n) S` and `S_{n+1} = (df/dx) dx + (df/ds_n) S`. `dr/ds_n S` and
+//! `f`'s derivatives are directional derivatives by central differences of the step's own
+//! functions at the converged increment (a residual per sign and direction): they are taken
+//! along one direction each, never assembled, so they agree with the step to the last digit
+//! the residual has, whatever the element; their truncation error at `EPSILON` of the state's
+//! scale is below 1e-10 relative, below the Newton tolerance.
+
+use super::{se3, Integrator, Layout, StepFailure};
+use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, log, M3, V3};
+use crate::runtime::{State, System, UnknownKind};
+use crate::settings::Method;
+
+/// The size of a direction's differences, relative to the state's scale (lengths in the
+/// model's length scale, rates over the tracked time scale).
+const EPSILON: f64 = 1e-6;
+
+/// The size of the accelerations' difference, relative to their scale: the residual is linear
+/// in them, so the step is large (far from round-off) and one-sided.
+const ACCELERATION_STEP: f64 = 1e-2;
+
+/// The directions carried along a run, and the step's workspace (made once).
+pub(super) struct Tracked {
+    /// Column-major `4 n x columns`.
+    pub(super) columns: Vec<f64>,
+    count: usize,
+    /// Per unknown, the scale of its position (the length scale for coordinates that are not
+    /// angles, 1 rad otherwise); rates are scaled by `tau`, accelerations by `tau^2`.
+    scale: Vec<f64>,
+    tau: f64,
+    nodes: Vec<NodeMap>,
+    dir: Vec<f64>,
+    moved: Vec<f64>,
+    part: Vec<f64>,
+    base: Vec<f64>,
+    gradient: Vec<f64>,
+}
+
+/// A node's part of one step's map ([`Integrator::transport`], [`Integrator::correct`]).
+#[derive(Clone, Copy, Default)]
+pub(super) struct NodeMap {
+    /// `R_D^T` of the increment `D`, and its translation `p_D = J_l(theta) u`.
+    rt: M3,
+    p: V3,
+    /// The increment's inverse right Jacobian `[[ja, jb], [0, ja]]`.
+    ja: M3,
+    jb: M3,
+}
+
+/// Whether unknown `i` is a coordinate integrated by Newmark in the flat slots (not a frame's
+/// or a rotation's, not a multiplier).
+fn flat(sys: &System, in_frame: &[bool], i: usize) -> bool {
+    !in_frame[i] && !sys.unknowns[i].is_multiplier()
+}
+
+/// Node `k`'s slots of frame component `j` (translations of frames only).
+fn slot(sys: &System, k: usize, j: usize) -> Option<usize> {
+    if j < 3 {
+        sys.is_frame(k).then(|| sys.translations[k] + j)
+    } else {
+        Some(sys.rotations[k] + j - 3)
+    }
+}
+
+/// `out = base (+) eps dir`: coordinates shifted, frames moved by body-frame increments,
+/// rates shifted; the nodes' inertial kinematics made to match.
+pub(super) fn perturb(
+    sys: &System,
+    in_frame: &[bool],
+    base: &State,
+    dir: &[f64],
+    eps: f64,
+    out: &mut State,
+) {
+    let n = sys.len();
+    out.assign(base);
+    for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
+        out.q[i] += eps * dir[i];
+        out.v[i] += eps * dir[n + i];
+        out.a[i] += eps * dir[2 * n + i];
+        out.alg[i] += eps * dir[3 * n + i];
+    }
+    for k in 0..sys.rotations.len() {
+        let d: [f64; 6] = std::array::from_fn(|j| slot(sys, k, j).map_or(0.0, |s| eps * dir[s]));
+        se3::displace(sys, base, out, k, &d);
+        let f = &mut out.frames[k];
+        for j in 0..6 {
+            if let Some(s) = slot(sys, k, j) {
+                f.v[j] += eps * dir[n + s];
+                f.dv[j] += eps * dir[2 * n + s];
+                f.alg[j] += eps * dir[3 * n + s];
+            }
+        }
+        se3::to_physical(sys, out, k);
+    }
+}
+
+/// `out = a (-) b`, the direction that [`perturb`] takes from `b` to `a` (to first order).
+pub(super) fn difference(sys: &System, in_frame: &[bool], a: &State, b: &State, out: &mut [f64]) {
+    let n = sys.len();
+    out.iter_mut().for_each(|x| *x = 0.0);
+    for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
+        out[i] = a.q[i] - b.q[i];
+        out[n + i] = a.v[i] - b.v[i];
+        out[2 * n + i] = a.a[i] - b.a[i];
+        out[3 * n + i] = a.alg[i] - b.alg[i];
+    }
+    for k in 0..sys.rotations.len() {
+        let rb = b.rot[k].matrix();
+        let th = log(&(rb.transpose() * a.rot[k].matrix()));
+        let (t, r) = (sys.translations[k], sys.rotations[k]);
+        if sys.is_frame(k) {
+            let dx = V3::new(
+                a.q[t] - b.q[t],
+                a.q[t + 1] - b.q[t + 1],
+                a.q[t + 2] - b.q[t + 2],
+            );
+            let u = left_jacobian_inverse(&th) * (rb.transpose() * dx);
+            out[t..t + 3].copy_from_slice(u.as_slice());
+        }
+        out[r..r + 3].copy_from_slice(th.as_slice());
+        let (fa, fb) = (&a.frames[k], &b.frames[k]);
+        for j in 0..6 {
+            if let Some(s) = slot(sys, k, j) {
+                out[n + s] = fa.v[j] - fb.v[j];
+                out[2 * n + s] = fa.dv[j] - fb.dv[j];
+                out[3 * n + s] = fa.alg[j] - fb.alg[j];
+            }
+        }
+    }
+}
+
+impl Tracked {
+    /// The scaled sizes of a direction of the end state: the largest of its positions over
+    /// their scale and its rates times `tau` over the position's scale; and of its
+    /// accelerations times `tau^2`.
+    fn sizes(&self, dir: &[f64]) -> (f64, f64) {
+        let n = self.scale.len();
+        let t = self.tau;
+        let (mut moving, mut accelerating) = (0.0f64, 0.0f64);
+        for (i, s) in self.scale.iter().enumerate() {
+            moving = moving.max(dir[i].abs() / s).max(t * dir[n + i].abs() / s);
+            accelerating = accelerating.max(t * t * dir[2 * n + i].abs() / s);
+        }
+        (moving, accelerating)
+    }
+}
+
+impl Integrator<'_> {
+    /// Whether the step's tangent can be carried: the Newmark family with the incremental
+    /// rotation treatment (time finite elements and conformal rotations cannot yet).
+    pub fn can_track(&self) -> bool {
+        self.layout == Layout::Increments
+            && matches!(self.method, Method::Hht | Method::GeneralizedAlpha)
+    }
+
+    /// The length of a direction of the step's state.
+    pub fn direction_len(&self) -> usize {
+        4 * self.sys.len()
+    }
+
+    /// Carries the directions `columns` (column-major, [`Integrator::direction_len`] rows)
+    /// through every step from now on; `tau` is the motion's time scale (rates are compared
+    /// with positions over it).
+    pub fn track(&mut self, columns: Vec<f64>, tau: f64) {
+        let (n, nodes) = (self.sys.len(), self.sys.rotations.len());
+        let count = columns.len() / (4 * n).max(1);
+        let angles = self.sys.angle_unknowns();
+        let scale = (0..n)
+            .map(|i| match self.sys.unknowns[i] {
+                UnknownKind::Coordinate if !angles.contains(&i) => self.sys.length_scale,
+                _ => 1.0,
+            })
+            .collect();
+        self.tracked = Some(Box::new(Tracked {
+            columns,
+            count,
+            scale,
+            tau,
+            nodes: vec![NodeMap::default(); nodes],
+            dir: vec![0.0; 4 * n],
+            moved: vec![0.0; 4 * n],
+            part: vec![0.0; 4 * n],
+            base: vec![0.0; n],
+            gradient: vec![0.0; n],
+        }));
+    }
+
+    /// The carried directions at the current state.
+    pub fn tracked(&self) -> Option<&[f64]> {
+        self.tracked.as_ref().map(|t| t.columns.as_slice())
+    }
+
+    /// `out = base (+) eps dir` in this integrator's state layout (see [`perturb`]).
+    pub fn perturb_state(&self, base: &State, dir: &[f64], eps: f64, out: &mut State) {
+        perturb(self.sys, &self.in_frame, base, dir, eps, out);
+    }
+
+    /// `out = a (-) b` in this integrator's state layout (see [`difference`]).
+    pub fn state_difference(&self, a: &State, b: &State, out: &mut [f64]) {
+        difference(self.sys, &self.in_frame, a, b, out);
+    }
+
+    /// After a converged step of `h` (`cur` its end, the step's increments in `step_q`,
+    /// `step_frames`): the carried directions moved to its end.
+    pub(super) fn propagate(&mut self, h: f64) -> Result<(), StepFailure> {
+        let Some(mut tk) = self.tracked.take() else {
+            return Ok(());
+        };
+        let result = self.propagate_with(h, &mut tk);
+        self.tracked = Some(tk);
+        result
+    }
+
+    /// Each node's part of the step's map: `exp(-increment)`'s action on a body-frame
+    /// perturbation of the start, and the increment's inverse right Jacobian.
+    pub(super) fn node_maps(&self, nodes: &mut [NodeMap]) {
+        for (k, m) in nodes.iter_mut().enumerate() {
+            let d = &self.step_frames[k];
+            let (u, th) = (V3::new(d[0], d[1], d[2]), V3::new(d[3], d[4], d[5]));
+            m.rt = exp(&th).transpose();
+            if self.sys.is_frame(k) {
+                m.p = left_jacobian(&th) * u;
+                (m.ja, m.jb) = se3::right_jacobian_inverse(d);
+            } else {
+                m.p = V3::zeros();
+                (m.ja, m.jb) = (left_jacobian_inverse(&-th), M3::zeros());
+            }
+        }
+    }
+
+    /// `out = T dir`: where a perturbation `dir` of the step's start moves its end at a fixed
+    /// increment. Coordinates keep their shift; a frame's body-frame perturbation `d` of the
+    /// start becomes `Ad(exp(-D)) d` at the end (`H exp(d) exp(D) = H exp(D) exp(Ad d)`):
+    /// `R_D^T (du - p_D x dtheta)`, `R_D^T dtheta`; the rates move by the Newmark relations
+    /// at a zero increment.
+    pub(super) fn transport(&self, h: f64, nodes: &[NodeMap], dir: &[f64], out: &mut [f64]) {
+        let (n, sc) = (self.sys.len(), self.sc);
+        let g = |x: &[f64], i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
+        out.iter_mut().for_each(|x| *x = 0.0);
+        for i in (0..n).filter(|&i| !self.sys.unknowns[i].is_multiplier()) {
+            (out[n + i], out[2 * n + i], out[3 * n + i]) =
+                sc.relation(h, 0.0, dir[n + i], dir[2 * n + i], dir[3 * n + i]);
+            if !self.in_frame[i] {
+                out[i] = dir[i];
+            }
+        }
+        for (k, m) in nodes.iter().enumerate() {
+            let (t, r) = (self.sys.translations[k], self.sys.rotations[k]);
+            let th = g(dir, r);
+            if self.sys.is_frame(k) {
+                let u = m.rt * (g(dir, t) - m.p.cross(&th));
+                out[t..t + 3].copy_from_slice(u.as_slice());
+            }
+            out[r..r + 3].copy_from_slice((m.rt * th).as_slice());
+        }
+    }
+
+    /// `out += D x`: where a correction `x` of the step's increment (the Newton correction's
+    /// layout: a frame's end moves by `H exp(x)`) moves the end. Coordinates shift by it; the
+    /// rates move by the Newmark relations with the increment's change, `J_r^-1(D) x` for a
+    /// frame.
+    pub(super) fn correct(&self, h: f64, nodes: &[NodeMap], x: &[f64], out: &mut [f64]) {
+        let (n, sc) = (self.sys.len(), self.sc);
+        // Slot `s` moved by `x_s`, its increment by `d`.
+        let add = |out: &mut [f64], s: usize, d: f64| {
+            let (v, a, alg) = sc.relation(h, d, 0.0, 0.0, 0.0);
+            out[s] += x[s];
+            out[n + s] += v;
+            out[2 * n + s] += a;
+            out[3 * n + s] += alg;
+        };
+        for i in (0..n).filter(|&i| flat(self.sys, &self.in_frame, i)) {
+            add(out, i, x[i]);
+        }
+        let g = |i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
+        for (k, m) in nodes.iter().enumerate() {
+            let (t, r) = (self.sys.translations[k], self.sys.rotations[k]);
+            let th = g(r);
+            if self.sys.is_frame(k) {
+                let du = m.ja * g(t) + m.jb * th;
+                for j in 0..3 {
+                    add(out, t + j, du[j]);
+                }
+            }
+            let dth = m.ja * th;
+            for j in 0..3 {
+                add(out, r + j, dth[j]);
+            }
+        }
+    }
+
+    fn propagate_with(&mut self, h: f64, tk: &mut Tracked) -> Result<(), StepFailure> {
+        let (n, aug) = (self.sys.len(), self.aug);
+        let dim = 4 * n;
+        // The residual and the iteration matrix at the converged increment.
+        self.trial.assign(&self.cur);
+        self.newmark_residual(aug, 0.0)?;
+        tk.base.copy_from_slice(&self.rhs);
+        self.exact_rates = true;
+        let factored = self.refactor(h, aug, false);
+        self.exact_rates = false;
+        factored?;
+        self.node_maps(&mut tk.nodes);
+        for c in 0..tk.count {
+            tk.dir.copy_from_slice(&tk.columns[c * dim..(c + 1) * dim]);
+            self.transport(h, &tk.nodes, &tk.dir, &mut tk.moved);
+            // dr/ds S at the converged increment, `-r` being in `rhs`: the positions' and
+            // rates' part by central differences, the accelerations' (the residual is linear
+            // in them) by one difference from the converged residual.
+            tk.gradient.iter_mut().for_each(|x| *x = 0.0);
+            let (moving, accelerating) = tk.sizes(&tk.moved);
+            if moving > 0.0 {
+                tk.part.copy_from_slice(&tk.moved);
+                tk.part[2 * n..].iter_mut().for_each(|x| *x = 0.0);
+                let eps = EPSILON / moving;
+                for sign in [1.0, -1.0] {
+                    perturb(
+                        self.sys,
+                        &self.in_frame,
+                        &self.cur,
+                        &tk.part,
+                        sign * eps,
+                        &mut self.trial,
+                    );
+                    self.newmark_residual(aug, 0.0)?;
+                    for (g, r) in tk.gradient.iter_mut().zip(&self.rhs) {
+                        *g += sign * r / (2.0 * eps);
+                    }
+                }
+            }
+            if accelerating > 0.0 {
+                tk.part.iter_mut().for_each(|x| *x = 0.0);
+                tk.part[2 * n..3 * n].copy_from_slice(&tk.moved[2 * n..3 * n]);
+                let eps = ACCELERATION_STEP / accelerating;
+                perturb(
+                    self.sys,
+                    &self.in_frame,
+                    &self.cur,
+                    &tk.part,
+                    eps,
+                    &mut self.trial,
+                );
+                self.newmark_residual(aug, 0.0)?;
+                for ((g, r), b) in tk.gradient.iter_mut().zip(&self.rhs).zip(&tk.base) {
+                    *g += (r - b) / eps;
+                }
+            }
+            if moving > 0.0 || accelerating > 0.0 {
+                self.lu
+                    .solve_unrefined(&mut tk.gradient)
+                    .map_err(|e| self.singular(e))?;
+                self.correct(h, &tk.nodes, &tk.gradient, &mut tk.moved);
+            }
+            tk.columns[c * dim..(c + 1) * dim].copy_from_slice(&tk.moved);
+        }
+        self.trial.assign(&self.cur);
+        Ok(())
+    }
+}
