@@ -68,6 +68,8 @@ pub struct Assembler {
     /// Per element with inertia or damping: the frames among its unknowns, each with the
     /// local positions of its translation and rotation unknowns.
     rated: Rated,
+    /// The elements whose residual reads the rates ([`Element::reads_rates`]).
+    reading: Vec<usize>,
     pub residual: Residual,
     /// Generalized momenta `P = M(q) V` and transport terms `G` (`dP/dt + G = F^I`).
     pub momentum: Vec<f64>,
@@ -104,6 +106,9 @@ impl Assembler {
             local: vec![0.0; largest * largest],
             local2: vec![0.0; largest * largest],
             rated,
+            reading: (0..sys.elements.len())
+                .filter(|&e| sys.elements[e].reads_rates())
+                .collect(),
             residual: Residual::new(n),
             momentum: vec![0.0; n],
             transport: vec![0.0; n],
@@ -194,6 +199,15 @@ impl Assembler {
         self.residual.clear();
         for e in &sys.elements {
             e.residual(st, aug, &mut self.residual);
+        }
+    }
+
+    /// The residual parts of the elements that read the rates alone: its difference between
+    /// two states of the same positions is the whole residual's.
+    pub fn rate_residual(&mut self, sys: &System, st: &State, aug: Augment) {
+        self.residual.clear();
+        for &e in &self.reading {
+            sys.elements[e].residual(st, aug, &mut self.residual);
         }
     }
 

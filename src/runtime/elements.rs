@@ -34,6 +34,15 @@ impl Element {
     }
 
     /// Whether the tangent depends on the rates (inertia, damping).
+    /// Whether the element's residual reads velocities or accelerations: inertia, damping,
+    /// a joint's prescribed rate rows.
+    pub fn reads_rates(&self) -> bool {
+        match self {
+            Element::Joint(j) => j.rows.iter().any(|r| r.is_rate()),
+            _ => self.has_rates(),
+        }
+    }
+
     pub fn has_rates(&self) -> bool {
         match self {
             Element::PointMass(_) | Element::RigidBody(_) | Element::Beam(_) => true,

@@ -20,18 +20,17 @@
 //! the residual has, whatever the element; their truncation error at `EPSILON` of the state's
 //! scale is below 1e-10 relative, below the Newton tolerance.
 
-use super::{se3, Integrator, Layout, StepFailure};
+use super::newton::Reuse;
+use super::{rotations, se3, Integrator, Layout, StepFailure};
 use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, log, M3, V3};
 use crate::runtime::{State, System, UnknownKind};
-use crate::settings::Method;
+use crate::settings::{Method, NewtonMode};
 
-/// The size of a direction's differences, relative to the state's scale (lengths in the
-/// model's length scale, rates over the tracked time scale).
-const EPSILON: f64 = 1e-6;
-
-/// The size of the accelerations' difference, relative to their scale: the residual is linear
-/// in them, so the step is large (far from round-off) and one-sided.
-const ACCELERATION_STEP: f64 = 1e-2;
+/// The size of a direction's differences of the rates, relative to their scale (lengths in
+/// the model's length scale over the tracked time scale): the residual is quadratic in the
+/// velocities and linear in the accelerations, so the differences are exact but for
+/// round-off, which a large step keeps small.
+const EPSILON: f64 = 1e-3;
 
 /// The directions carried along a run, and the step's workspace (made once).
 pub(super) struct Tracked {
@@ -46,7 +45,6 @@ pub(super) struct Tracked {
     dir: Vec<f64>,
     moved: Vec<f64>,
     part: Vec<f64>,
-    base: Vec<f64>,
     gradient: Vec<f64>,
 }
 
@@ -145,18 +143,18 @@ pub(super) fn difference(sys: &System, in_frame: &[bool], a: &State, b: &State, 
 }
 
 impl Tracked {
-    /// The scaled sizes of a direction of the end state: the largest of its positions over
-    /// their scale and its rates times `tau` over the position's scale; and of its
-    /// accelerations times `tau^2`.
-    fn sizes(&self, dir: &[f64]) -> (f64, f64) {
+    /// The scaled size of a direction's rates: the largest of its rates times `tau` and its
+    /// accelerations times `tau^2`, over the position's scale.
+    fn rate_size(&self, dir: &[f64]) -> f64 {
         let n = self.scale.len();
         let t = self.tau;
-        let (mut moving, mut accelerating) = (0.0f64, 0.0f64);
+        let mut size = 0.0f64;
         for (i, s) in self.scale.iter().enumerate() {
-            moving = moving.max(dir[i].abs() / s).max(t * dir[n + i].abs() / s);
-            accelerating = accelerating.max(t * t * dir[2 * n + i].abs() / s);
+            size = size
+                .max(t * dir[n + i].abs() / s)
+                .max(t * t * dir[2 * n + i].abs() / s);
         }
-        (moving, accelerating)
+        size
     }
 }
 
@@ -186,6 +184,11 @@ impl Integrator<'_> {
                 _ => 1.0,
             })
             .collect();
+        // Each step ends with the matrix factored at its converged state, which the next
+        // step's Newton keeps while it contracts (its first matrix costs nothing then).
+        if self.set.newton != NewtonMode::Full {
+            self.reuse = Reuse::new(NewtonMode::Modified, self.method);
+        }
         self.tracked = Some(Box::new(Tracked {
             columns,
             count,
@@ -194,8 +197,7 @@ impl Integrator<'_> {
             nodes: vec![NodeMap::default(); nodes],
             dir: vec![0.0; 4 * n],
             moved: vec![0.0; 4 * n],
-            part: vec![0.0; 4 * n],
-            base: vec![0.0; n],
+            part: vec![0.0; n],
             gradient: vec![0.0; n],
         }));
     }
@@ -310,7 +312,6 @@ impl Integrator<'_> {
         // The residual and the iteration matrix at the converged increment.
         self.trial.assign(&self.cur);
         self.newmark_residual(aug, 0.0)?;
-        tk.base.copy_from_slice(&self.rhs);
         self.exact_rates = true;
         let factored = self.refactor(h, aug, false);
         self.exact_rates = false;
@@ -319,48 +320,43 @@ impl Integrator<'_> {
         for c in 0..tk.count {
             tk.dir.copy_from_slice(&tk.columns[c * dim..(c + 1) * dim]);
             self.transport(h, &tk.nodes, &tk.dir, &mut tk.moved);
-            // dr/ds S at the converged increment, `-r` being in `rhs`: the positions' and
-            // rates' part by central differences, the accelerations' (the residual is linear
-            // in them) by one difference from the converged residual.
-            tk.gradient.iter_mut().for_each(|x| *x = 0.0);
-            let (moving, accelerating) = tk.sizes(&tk.moved);
-            if moving > 0.0 {
-                tk.part.copy_from_slice(&tk.moved);
-                tk.part[2 * n..].iter_mut().for_each(|x| *x = 0.0);
-                let eps = EPSILON / moving;
+            // The end's perturbation `m` as a correction of the increment by its positions
+            // `x_m` (`D x_m`, whose residual is `J x_m`) and a perturbation of the rates alone,
+            // `w = m - D x_m`. Then `x = -x_m - J^-1 r_w` and `S' = w + D (x + x_m)`
+            // `= w - D J^-1 r_w`: the positions' part is exact through `J`, and `r_w`, the
+            // residual's derivative along rates at fixed positions, is quadratic in the
+            // velocities and linear in the accelerations: its central differences are exact
+            // to round-off.
+            tk.part.copy_from_slice(&tk.moved[..n]);
+            tk.part.iter_mut().for_each(|x| *x = -*x);
+            self.correct(h, &tk.nodes, &tk.part, &mut tk.moved);
+            let size = tk.rate_size(&tk.moved);
+            if size > 0.0 {
+                let eps = EPSILON / size;
+                tk.gradient.iter_mut().for_each(|x| *x = 0.0);
                 for sign in [1.0, -1.0] {
                     perturb(
                         self.sys,
                         &self.in_frame,
                         &self.cur,
-                        &tk.part,
+                        &tk.moved,
                         sign * eps,
                         &mut self.trial,
                     );
-                    self.newmark_residual(aug, 0.0)?;
-                    for (g, r) in tk.gradient.iter_mut().zip(&self.rhs) {
-                        *g += sign * r / (2.0 * eps);
+                    // Only the elements that read the rates: the others' parts cancel.
+                    self.asm.rate_residual(self.sys, &self.trial, aug);
+                    let r = &self.asm.residual;
+                    for (i, g) in tk.gradient.iter_mut().enumerate() {
+                        *g -= sign / (2.0 * eps)
+                            * if self.sys.unknowns[i].is_multiplier() {
+                                aug.s * r.constraint[i]
+                            } else {
+                                r.inertia[i] + r.force[i]
+                            };
                     }
                 }
-            }
-            if accelerating > 0.0 {
-                tk.part.iter_mut().for_each(|x| *x = 0.0);
-                tk.part[2 * n..3 * n].copy_from_slice(&tk.moved[2 * n..3 * n]);
-                let eps = ACCELERATION_STEP / accelerating;
-                perturb(
-                    self.sys,
-                    &self.in_frame,
-                    &self.cur,
-                    &tk.part,
-                    eps,
-                    &mut self.trial,
-                );
-                self.newmark_residual(aug, 0.0)?;
-                for ((g, r), b) in tk.gradient.iter_mut().zip(&self.rhs).zip(&tk.base) {
-                    *g += (r - b) / eps;
-                }
-            }
-            if moving > 0.0 || accelerating > 0.0 {
+                // In the treatment's unknowns (the blocks' `R` at the end, as `rhs`).
+                rotations::transform_vector(&self.blocks, &self.mats, &mut tk.gradient);
                 self.lu
                     .solve_unrefined(&mut tk.gradient)
                     .map_err(|e| self.singular(e))?;
