@@ -23,8 +23,10 @@ own tangent, 2 n_f directions of the state carried through one run of the period
 converged steps' iteration matrices (the HHT and generalized-alpha integrators with \
 incremental rotations; --monodromy runs, time finite elements and conformal rotations build \
 it from 4 n_f + 1 perturbed runs of one period), n_f the free coordinates. Exponents s = (ln|Lambda| + \
-i arg Lambda) / T; the frequency is known only modulo 2 pi / T and is reported on the \
-principal branch, |Im s| <= pi / T.
+i arg Lambda) / T. A multiplier gives the frequency only modulo 2 pi / T: with the tangent, \
+the frequency is the principal branch's plus the dominant harmonic of the mode's time history \
+over the period (the blades' frequency for a mode of a rotor's lag angles); --monodromy runs \
+reports the principal branch, |Im s| <= pi / T.
 
 Prony (--method prony): the poles of a transient, the model's own run (its excitation \
 included), fitted by the matrix pencil method over --window (default: from a tenth of the run \

@@ -39,6 +39,8 @@
 //! in its size). The monodromy matrix is that of the discrete map, so its damping carries the
 //! integrator's numerical damping (§7.4).
 
+mod harmonics;
+
 use super::integrator::{Integrator, Linearization};
 use super::linear::{generalized_eigen, null_space};
 use super::modes::c64;
@@ -66,8 +68,13 @@ pub struct Floquet {
     pub monodromy: Vec<f64>,
     /// Characteristic multipliers, largest modulus first.
     pub multipliers: Vec<c64>,
-    /// Characteristic exponents (1/s), in the multipliers' order.
+    /// Characteristic exponents (1/s), in the multipliers' order, on the principal branch
+    /// `|Im s| <= pi / T`.
     pub exponents: Vec<c64>,
+    /// Each exponent's frequency (rad/s) resolved by the dominant harmonic of its mode's time
+    /// history over the period (THEORY §9.2 step 4): `Im s + l 2 pi / T`. From perturbed
+    /// runs, which keep no history, the principal branch's.
+    pub frequencies: Vec<f64>,
     /// Newton iterations over all runs.
     pub newton_iterations: usize,
     /// How the monodromy matrix was built.
@@ -278,12 +285,17 @@ pub fn floquet_by(
         start: it.state().clone(),
     };
     let how = if it.can_track() { how } else { Monodromy::Runs };
-    let (z0, zt, newton_iterations) = match how {
+    let Columns {
+        z0,
+        zt,
+        newton_iterations,
+        history,
+    } = match how {
         Monodromy::Tangent => by_tangent(sys, &mut it, &space, progress)?,
         Monodromy::Runs => by_runs(sys, &mut it, &space, progress)?,
     };
     let n = 2 * r;
-    let phi_m = match z0.lu().solve(&DMatrix::<f64>::identity(n, n)) {
+    let phi_m = match z0.clone().lu().solve(&DMatrix::<f64>::identity(n, n)) {
         Some(inv) => &zt * inv,
         None => {
             return Err(reference_failure(RuntimeFailure {
@@ -297,7 +309,7 @@ pub fn floquet_by(
         }
     };
     let phi: Vec<f64> = (0..n * n).map(|k| phi_m[(k % n, k / n)]).collect();
-    let multipliers = eigenvalues(&phi, n).ok_or_else(|| {
+    let modes = eigen(&phi, n).ok_or_else(|| {
         reference_failure(RuntimeFailure {
             kind: super::FailureKind::Singular,
             t: period,
@@ -306,7 +318,19 @@ pub fn floquet_by(
             detail: "the eigenvalues of the monodromy matrix could not be computed".into(),
         })
     })?;
-    let exponents = multipliers.iter().map(|&m| exponent(m, period)).collect();
+    let multipliers: Vec<c64> = modes.iter().map(|(m, _)| *m).collect();
+    let exponents: Vec<c64> = multipliers.iter().map(|&m| exponent(m, period)).collect();
+    let principal = || exponents.iter().map(|s| s.im).collect();
+    let frequencies = if history.len() > 2 {
+        let shapes: Vec<((f64, f64), Vec<(f64, f64)>)> = exponents
+            .iter()
+            .zip(modes)
+            .map(|(s, (_, v))| ((s.re, s.im), v))
+            .collect();
+        harmonics::resolve(&history, &z0, &shapes, period).unwrap_or_else(principal)
+    } else {
+        principal()
+    };
     Ok(Floquet {
         period,
         steps,
@@ -315,14 +339,20 @@ pub fn floquet_by(
         monodromy: phi,
         multipliers,
         exponents,
+        frequencies,
         newton_iterations,
         how,
     })
 }
 
-/// The columns of the perturbations at the start and after one period, and the Newton
-/// iterations they took.
-type Columns = (DMatrix<f64>, DMatrix<f64>, usize);
+/// The columns of the perturbations at the start and after one period, the Newton
+/// iterations they took, and (from the tangent) their history over the period.
+struct Columns {
+    z0: DMatrix<f64>,
+    zt: DMatrix<f64>,
+    newton_iterations: usize,
+    history: Vec<(f64, DMatrix<f64>)>,
+}
 
 /// The perturbed starts, each made consistent: their measure `Z_0` (central differences);
 /// `each(it, dir, sign)` is called with the integrator at each start.
@@ -379,8 +409,41 @@ fn by_tangent(
     })?;
     it.restart(&sys.initial).map_err(reference_failure)?;
     it.track(directions, 1.0 / space.omega);
-    let reference = integrate(it).map_err(reference_failure)?;
+    // The directions' measure at evenly spaced steps, for the modes' time histories.
+    let stride = (it.steps() / harmonics::SAMPLES).max(1);
+    let (t0, mut history) = (it.state().t, Vec::new());
+    history.push((0.0, z0.clone()));
+    it.run(|k, it| {
+        if k % stride == 0 && k < it.steps() {
+            history.push((
+                it.state().t - t0,
+                carried_measure(sys, it, space, it.state()),
+            ));
+        }
+        Ok::<(), Infallible>(())
+    })
+    .map_err(|s| match s {
+        Stop::Failed(f) => reference_failure(f),
+        Stop::Stopped(never) => match never {},
+    })?;
     progress();
+    let zt = carried_measure(sys, it, space, it.state());
+    Ok(Columns {
+        z0,
+        zt,
+        newton_iterations: it.stats().newton_iterations,
+        history,
+    })
+}
+
+/// The measure of the carried directions at the integrator's current state `reference`.
+fn carried_measure(
+    sys: &System,
+    it: &Integrator,
+    space: &Space,
+    reference: &State,
+) -> DMatrix<f64> {
+    let (n, dim) = (2 * space.r, it.direction_len());
     let carried = it.tracked().unwrap_or_default();
     let mut zt = DMatrix::<f64>::zeros(n, n);
     let mut st = reference.clone();
@@ -397,15 +460,15 @@ fn by_tangent(
             continue;
         }
         let e = 1e-6 / size;
-        it.perturb_state(&reference, col, e, &mut st);
-        let b = space.measure(sys, &st, &reference);
-        it.perturb_state(&reference, col, -e, &mut st);
-        let c = space.measure(sys, &st, &reference);
+        it.perturb_state(reference, col, e, &mut st);
+        let b = space.measure(sys, &st, reference);
+        it.perturb_state(reference, col, -e, &mut st);
+        let c = space.measure(sys, &st, reference);
         for i in 0..n {
             zt[(i, dir)] = (b[i] - c[i]) / (2.0 * e);
         }
     }
-    Ok((z0, zt, it.stats().newton_iterations))
+    zt
 }
 
 /// The monodromy's columns from `4 n_f` perturbed runs of one period.
@@ -433,7 +496,12 @@ fn by_runs(
         progress();
         Ok(())
     })?;
-    Ok((z0, zt, newton_iterations))
+    Ok(Columns {
+        z0,
+        zt,
+        newton_iterations,
+        history: Vec::new(),
+    })
 }
 
 /// The weighted perturbation space: the weights of the free coordinates (translations in
@@ -469,8 +537,10 @@ fn perturbation_space(
     Ok((weights, basis, r))
 }
 
-/// The eigenvalues of the `n x n` column-major matrix `phi`, by decreasing modulus.
-fn eigenvalues(phi: &[f64], n: usize) -> Option<Vec<c64>> {
+/// The eigenvalues of the `n x n` column-major matrix `phi` and their eigenvectors, by
+/// decreasing modulus.
+#[allow(clippy::type_complexity)]
+fn eigen(phi: &[f64], n: usize) -> Option<Vec<(c64, Vec<(f64, f64)>)>> {
     let identity: Vec<f64> = (0..n * n)
         .map(|k| if k % (n + 1) == 0 { 1.0 } else { 0.0 })
         .collect();
@@ -479,15 +549,18 @@ fn eigenvalues(phi: &[f64], n: usize) -> Option<Vec<c64>> {
     } else {
         generalized_eigen(phi, &identity, n)?
     };
-    let mut multipliers: Vec<c64> = eig
-        .iter()
-        .map(|((ar, ai), (br, bi), _)| {
+    let mut modes: Vec<(c64, Vec<(f64, f64)>)> = eig
+        .into_iter()
+        .map(|((ar, ai), (br, bi), v)| {
             // alpha / beta
             let d = br * br + bi * bi;
-            c64::new((ar * br + ai * bi) / d, (ai * br - ar * bi) / d)
+            (
+                c64::new((ar * br + ai * bi) / d, (ai * br - ar * bi) / d),
+                v,
+            )
         })
         .collect();
     let modulus = |m: &c64| (m.re * m.re + m.im * m.im).sqrt();
-    multipliers.sort_by(|a, b| modulus(b).total_cmp(&modulus(a)));
-    Some(multipliers)
+    modes.sort_by(|a, b| modulus(&b.0).total_cmp(&modulus(&a.0)));
+    Some(modes)
 }

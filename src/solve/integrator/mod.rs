@@ -247,6 +247,11 @@ impl<'s> Integrator<'s> {
         &self.cur
     }
 
+    /// The steps of a run (the settings').
+    pub fn steps(&self) -> usize {
+        self.set.steps
+    }
+
     pub fn augment(&self) -> Augment {
         self.aug
     }

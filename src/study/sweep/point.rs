@@ -261,8 +261,12 @@ fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Found {
             }
         },
     )?;
+    // The frequencies resolved by each mode's dominant harmonic (THEORY §9.2 step 4).
+    let resolved: Vec<c64> = (f.exponents.iter().zip(&f.frequencies))
+        .map(|(s, &w)| c64::new(s.re, w))
+        .collect();
     Ok((
-        modes_of(&f.exponents),
+        modes_of(&resolved),
         format!(
             "{} free coordinates, {} steps of {:.4e} s per period {:.6} s",
             f.free, f.steps, f.dt, f.period
