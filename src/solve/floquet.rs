@@ -322,7 +322,7 @@ pub fn floquet_by(
     let exponents: Vec<c64> = multipliers.iter().map(|&m| exponent(m, period)).collect();
     let principal = || exponents.iter().map(|s| s.im).collect();
     let frequencies = if history.len() > 2 {
-        let shapes: Vec<((f64, f64), Vec<(f64, f64)>)> = exponents
+        let shapes: Vec<harmonics::Mode> = exponents
             .iter()
             .zip(modes)
             .map(|(s, (_, v))| ((s.re, s.im), v))

@@ -6,6 +6,10 @@
 
 use nalgebra::{Complex, DMatrix, DVector};
 
+/// A mode: its exponent `(Re s, Im s)` on the principal branch and its eigenvector (complex
+/// entries as `(re, im)`).
+pub type Mode = ((f64, f64), Vec<(f64, f64)>);
+
 /// Harmonics looked at: `|l| <= MAX_HARMONIC` (a rotor's modes sit within a few per rev of
 /// their principal branch).
 pub const MAX_HARMONIC: i32 = 8;
@@ -18,7 +22,7 @@ pub const SAMPLES: usize = 48;
 pub fn resolve(
     history: &[(f64, DMatrix<f64>)],
     z0: &DMatrix<f64>,
-    modes: &[((f64, f64), Vec<(f64, f64)>)],
+    modes: &[Mode],
     period: f64,
 ) -> Option<Vec<f64>> {
     let lu = z0.clone().lu();
