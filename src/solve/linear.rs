@@ -199,6 +199,29 @@ impl SparseLu {
         self.solve_with(rhs, false)
     }
 
+    /// As [`SparseLu::solve_unrefined`] for `count` right-hand sides at once (column-major).
+    pub fn solve_many_unrefined(
+        &mut self,
+        rhs: &mut [f64],
+        count: usize,
+    ) -> Result<(), LinearError> {
+        let n = self.pattern.n;
+        match &mut self.fast {
+            Some(fast) if self.factored && self.tiny.is_none() => {
+                fast.substitute_many(rhs, count);
+                if rhs.iter().all(|x| x.is_finite()) {
+                    Ok(())
+                } else {
+                    Err(LinearError::NonFinite)
+                }
+            }
+            _ => rhs
+                .chunks_mut(n.max(1))
+                .take(count)
+                .try_for_each(|col| self.solve_with(col, false)),
+        }
+    }
+
     fn solve_with(&mut self, rhs: &mut [f64], refine: bool) -> Result<(), LinearError> {
         if !self.factored {
             return Err(LinearError::Singular);

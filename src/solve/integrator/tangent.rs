@@ -43,10 +43,13 @@ pub(super) struct Tracked {
     tau: f64,
     nodes: Vec<NodeMap>,
     dir: Vec<f64>,
-    moved: Vec<f64>,
     part: Vec<f64>,
-    gradient: Vec<f64>,
+    /// Column-major `n x columns`: each direction's correction of the increment.
+    gradients: Vec<f64>,
 }
+
+/// The Newmark relations as a matrix ([`Integrator::coefficients`]).
+pub(super) type Coefficients = [[f64; 4]; 3];
 
 /// A node's part of one step's map ([`Integrator::transport`], [`Integrator::correct`]).
 #[derive(Clone, Copy, Default)]
@@ -142,20 +145,17 @@ pub(super) fn difference(sys: &System, in_frame: &[bool], a: &State, b: &State, 
     }
 }
 
-impl Tracked {
-    /// The scaled size of a direction's rates: the largest of its rates times `tau` and its
-    /// accelerations times `tau^2`, over the position's scale.
-    fn rate_size(&self, dir: &[f64]) -> f64 {
-        let n = self.scale.len();
-        let t = self.tau;
-        let mut size = 0.0f64;
-        for (i, s) in self.scale.iter().enumerate() {
-            size = size
-                .max(t * dir[n + i].abs() / s)
-                .max(t * t * dir[2 * n + i].abs() / s);
-        }
-        size
+/// The scaled size of a direction's rates: the largest of its rates times `tau` and its
+/// accelerations times `tau^2`, over the position's scale.
+fn rate_size(scale: &[f64], tau: f64, dir: &[f64]) -> f64 {
+    let n = scale.len();
+    let mut size = 0.0f64;
+    for (i, s) in scale.iter().enumerate() {
+        size = size
+            .max(tau * dir[n + i].abs() / s)
+            .max(tau * tau * dir[2 * n + i].abs() / s);
     }
+    size
 }
 
 impl Integrator<'_> {
@@ -196,9 +196,8 @@ impl Integrator<'_> {
             tau,
             nodes: vec![NodeMap::default(); nodes],
             dir: vec![0.0; 4 * n],
-            moved: vec![0.0; 4 * n],
             part: vec![0.0; n],
-            gradient: vec![0.0; n],
+            gradients: vec![0.0; n * count],
         }));
     }
 
@@ -228,6 +227,24 @@ impl Integrator<'_> {
         result
     }
 
+    /// The Newmark relations of a step of `h` as a matrix: row `k` of (rate, acceleration,
+    /// algorithmic acceleration) over (increment, rate, acceleration, algorithmic
+    /// acceleration) of the start.
+    pub(super) fn coefficients(&self, h: f64) -> Coefficients {
+        let unit = |k: usize| {
+            let e = |j: usize| if j == k { 1.0 } else { 0.0 };
+            self.sc.relation(h, e(0), e(1), e(2), e(3))
+        };
+        let cols = [unit(0), unit(1), unit(2), unit(3)];
+        std::array::from_fn(|r| {
+            std::array::from_fn(|k| match r {
+                0 => cols[k].0,
+                1 => cols[k].1,
+                _ => cols[k].2,
+            })
+        })
+    }
+
     /// Each node's part of the step's map: `exp(-increment)`'s action on a body-frame
     /// perturbation of the start, and the increment's inverse right Jacobian.
     pub(super) fn node_maps(&self, nodes: &mut [NodeMap]) {
@@ -250,13 +267,21 @@ impl Integrator<'_> {
     /// start becomes `Ad(exp(-D)) d` at the end (`H exp(d) exp(D) = H exp(D) exp(Ad d)`):
     /// `R_D^T (du - p_D x dtheta)`, `R_D^T dtheta`; the rates move by the Newmark relations
     /// at a zero increment.
-    pub(super) fn transport(&self, h: f64, nodes: &[NodeMap], dir: &[f64], out: &mut [f64]) {
-        let (n, sc) = (self.sys.len(), self.sc);
+    pub(super) fn transport(
+        &self,
+        coef: &Coefficients,
+        nodes: &[NodeMap],
+        dir: &[f64],
+        out: &mut [f64],
+    ) {
+        let n = self.sys.len();
         let g = |x: &[f64], i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
         out.iter_mut().for_each(|x| *x = 0.0);
         for i in (0..n).filter(|&i| !self.sys.unknowns[i].is_multiplier()) {
-            (out[n + i], out[2 * n + i], out[3 * n + i]) =
-                sc.relation(h, 0.0, dir[n + i], dir[2 * n + i], dir[3 * n + i]);
+            let (v, a, alg) = (dir[n + i], dir[2 * n + i], dir[3 * n + i]);
+            for (k, c) in coef.iter().enumerate() {
+                out[(k + 1) * n + i] = c[1] * v + c[2] * a + c[3] * alg;
+            }
             if !self.in_frame[i] {
                 out[i] = dir[i];
             }
@@ -276,15 +301,20 @@ impl Integrator<'_> {
     /// layout: a frame's end moves by `H exp(x)`) moves the end. Coordinates shift by it; the
     /// rates move by the Newmark relations with the increment's change, `J_r^-1(D) x` for a
     /// frame.
-    pub(super) fn correct(&self, h: f64, nodes: &[NodeMap], x: &[f64], out: &mut [f64]) {
-        let (n, sc) = (self.sys.len(), self.sc);
+    pub(super) fn correct(
+        &self,
+        coef: &Coefficients,
+        nodes: &[NodeMap],
+        x: &[f64],
+        out: &mut [f64],
+    ) {
+        let n = self.sys.len();
         // Slot `s` moved by `x_s`, its increment by `d`.
         let add = |out: &mut [f64], s: usize, d: f64| {
-            let (v, a, alg) = sc.relation(h, d, 0.0, 0.0, 0.0);
             out[s] += x[s];
-            out[n + s] += v;
-            out[2 * n + s] += a;
-            out[3 * n + s] += alg;
+            out[n + s] += coef[0][0] * d;
+            out[2 * n + s] += coef[1][0] * d;
+            out[3 * n + s] += coef[2][0] * d;
         };
         for i in (0..n).filter(|&i| flat(self.sys, &self.in_frame, i)) {
             add(out, i, x[i]);
@@ -317,9 +347,12 @@ impl Integrator<'_> {
         self.exact_rates = false;
         factored?;
         self.node_maps(&mut tk.nodes);
+        let coef = self.coefficients(h);
+        tk.gradients.iter_mut().for_each(|x| *x = 0.0);
         for c in 0..tk.count {
             tk.dir.copy_from_slice(&tk.columns[c * dim..(c + 1) * dim]);
-            self.transport(h, &tk.nodes, &tk.dir, &mut tk.moved);
+            let moved = &mut tk.columns[c * dim..(c + 1) * dim];
+            self.transport(&coef, &tk.nodes, &tk.dir, moved);
             // The end's perturbation `m` as a correction of the increment by its positions
             // `x_m` (`D x_m`, whose residual is `J x_m`) and a perturbation of the rates alone,
             // `w = m - D x_m`. Then `x = -x_m - J^-1 r_w` and `S' = w + D (x + x_m)`
@@ -327,42 +360,46 @@ impl Integrator<'_> {
             // residual's derivative along rates at fixed positions, is quadratic in the
             // velocities and linear in the accelerations: its central differences are exact
             // to round-off.
-            tk.part.copy_from_slice(&tk.moved[..n]);
+            tk.part.copy_from_slice(&moved[..n]);
             tk.part.iter_mut().for_each(|x| *x = -*x);
-            self.correct(h, &tk.nodes, &tk.part, &mut tk.moved);
-            let size = tk.rate_size(&tk.moved);
-            if size > 0.0 {
-                let eps = EPSILON / size;
-                tk.gradient.iter_mut().for_each(|x| *x = 0.0);
-                for sign in [1.0, -1.0] {
-                    perturb(
-                        self.sys,
-                        &self.in_frame,
-                        &self.cur,
-                        &tk.moved,
-                        sign * eps,
-                        &mut self.trial,
-                    );
-                    // Only the elements that read the rates: the others' parts cancel.
-                    self.asm.rate_residual(self.sys, &self.trial, aug);
-                    let r = &self.asm.residual;
-                    for (i, g) in tk.gradient.iter_mut().enumerate() {
-                        *g -= sign / (2.0 * eps)
-                            * if self.sys.unknowns[i].is_multiplier() {
-                                aug.s * r.constraint[i]
-                            } else {
-                                r.inertia[i] + r.force[i]
-                            };
-                    }
-                }
-                // In the treatment's unknowns (the blocks' `R` at the end, as `rhs`).
-                rotations::transform_vector(&self.blocks, &self.mats, &mut tk.gradient);
-                self.lu
-                    .solve_unrefined(&mut tk.gradient)
-                    .map_err(|e| self.singular(e))?;
-                self.correct(h, &tk.nodes, &tk.gradient, &mut tk.moved);
+            self.correct(&coef, &tk.nodes, &tk.part, moved);
+            let size = rate_size(&tk.scale, tk.tau, moved);
+            if size == 0.0 {
+                continue;
             }
-            tk.columns[c * dim..(c + 1) * dim].copy_from_slice(&tk.moved);
+            let eps = EPSILON / size;
+            let gradient = &mut tk.gradients[c * n..(c + 1) * n];
+            for sign in [1.0, -1.0] {
+                perturb(
+                    self.sys,
+                    &self.in_frame,
+                    &self.cur,
+                    moved,
+                    sign * eps,
+                    &mut self.trial,
+                );
+                // Only the elements that read the rates: the others' parts cancel.
+                self.asm.rate_residual(self.sys, &self.trial, aug);
+                let r = &self.asm.residual;
+                for (i, g) in gradient.iter_mut().enumerate() {
+                    *g -= sign / (2.0 * eps)
+                        * if self.sys.unknowns[i].is_multiplier() {
+                            aug.s * r.constraint[i]
+                        } else {
+                            r.inertia[i] + r.force[i]
+                        };
+                }
+            }
+            // In the treatment's unknowns (the blocks' `R` at the end, as `rhs`).
+            rotations::transform_vector(&self.blocks, &self.mats, gradient);
+        }
+        // Every direction's `J^-1 r_w` at once.
+        self.lu
+            .solve_many_unrefined(&mut tk.gradients, tk.count)
+            .map_err(|e| self.singular(e))?;
+        for c in 0..tk.count {
+            let moved = &mut tk.columns[c * dim..(c + 1) * dim];
+            self.correct(&coef, &tk.nodes, &tk.gradients[c * n..(c + 1) * n], moved);
         }
         self.trial.assign(&self.cur);
         Ok(())

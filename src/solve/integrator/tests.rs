@@ -173,8 +173,9 @@ impl Integrator<'_> {
                     }
                 }
             }
-            self.transport(h, &nodes, &dir, &mut analytic);
-            self.correct(h, &nodes, &x, &mut analytic);
+            let coef = self.coefficients(h);
+            self.transport(&coef, &nodes, &dir, &mut analytic);
+            self.correct(&coef, &nodes, &x, &mut analytic);
             let eps = 1e-6;
             for (sign, out) in [(1.0, &mut plus), (-1.0, &mut minus)] {
                 let e = sign * eps;
