@@ -1,6 +1,7 @@
 //! Benchmarks of the rotor analyses on the windmill (P5): the paper's 3 s run (6,000 steps of
 //! HHT -0.1), and one point of a stability sweep by each method at Omega_bar = 1.5 (Floquet:
-//! 21 runs of one period, 1,396 steps each; Prony: the 3 s run and the matrix-pencil fit). The
+//! the step's tangent carried through one run of the period, the 10 perturbed starts made
+//! consistent; Prony: the 3 s run and the matrix-pencil fit). The
 //! 3 s run is also timed with the matrix kept (`newton = auto`). A 50-point sweep costs about
 //! 50 Floquet points over the cores; its wall time is measured by `mbd stability` itself (see
 //! the closing note of issue 7).
