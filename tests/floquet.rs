@@ -165,9 +165,8 @@ fn floquet_frequencies_are_the_blades_frequencies_of_the_multiblade_modes() {
 /// branch; a value that is neither `tangent` nor `runs` is a usage error.
 #[test]
 fn the_stability_command_takes_either_monodromy() {
-    let largest = |how: &str| {
-        let out = temp(&format!("monodromy_{how}.csv"), "");
-        let o = mbd(&[
+    let stability = |how: &str, out: &str| {
+        mbd(&[
             "stability",
             "models/windmill.mbd",
             "--sweep",
@@ -175,8 +174,12 @@ fn the_stability_command_takes_either_monodromy() {
             "--monodromy",
             how,
             "-o",
-            out.to_str().expect("path"),
-        ]);
+            out,
+        ])
+    };
+    let largest = |how: &str| {
+        let out = temp(&format!("monodromy_{how}.csv"), "");
+        let o = stability(how, out.to_str().expect("path"));
         assert_eq!(code(&o), 0, "{}", stderr(&o));
         let text = std::fs::read_to_string(&out).expect("csv");
         let row: Vec<String> = text
@@ -199,15 +202,6 @@ fn the_stability_command_takes_either_monodromy() {
     );
     // The regressing mode at its blades' frequency both ways (within the principal branch).
     assert!((tangent.1 - runs.1).abs() < 1e-5, "{tangent:?} vs {runs:?}");
-    let o = mbd(&[
-        "stability",
-        "models/windmill.mbd",
-        "--sweep",
-        "Omega_bar=1.5:1.5:0.1",
-        "--monodromy",
-        "both",
-        "-o",
-        "x.csv",
-    ]);
+    let o = stability("both", "x.csv");
     assert_eq!(code(&o), 2, "{}", stderr(&o));
 }
