@@ -497,8 +497,8 @@ fn a_fan_plot_follows_the_flap_mode_against_the_rotor_speed() {
     let chart = std::fs::read_to_string(&svg).expect("svg");
     crate::charts::check(&chart, Some("fan"));
     assert!(
-        chart.contains("1/rev") && chart.contains("mode 1"),
-        "per-rev lines and the mode"
+        chart.contains("1/rev") && chart.contains("mode 1") && chart.contains("Re s [1/s]"),
+        "per-rev lines, the mode and the real parts' panel"
     );
     // A unit that is not an angular velocity is refused before any run.
     let o = mbd(&[

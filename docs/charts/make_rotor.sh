@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Regenerates the rotor charts of docs/charts/ (issue 7): the windmill's (P5) stability band
 # against Omega_bar by Floquet and Prony with the multiblade eigenvalues computed independently
-# (examples/windmill_mbc.rs), its lag and hub responses at Omega_bar 1.0 and 2.0 (the paper's
+# (examples/windmill_mbc.rs) and its Campbell diagram, its lag and hub responses at Omega_bar 1.0 and 2.0 (the paper's
 # Figs. 19-21) with the rotor's centre of mass (Fig. 22), and the spin-up (P6, Fig. 24) for
 # both torques.
 # Usage: docs/charts/make_rotor.sh   (from anywhere; builds the release binary first)
@@ -15,6 +15,8 @@ target/release/examples/windmill_mbc 4 > "$out/p5_mbc.csv"
 "$mbd" stability models/windmill.mbd --sweep Omega_bar=0.8:2.6:0.05 --method both \
     --reference "$out/p5_mbc.csv" -o "$out/p5_stability.csv" --chart "$out/p5_stability.svg" \
     | tee "$out/p5_stability.txt"
+"$mbd" stability models/windmill.mbd --sweep Omega_bar=0.8:2.6:0.05 --refine 0 \
+    --chart-kind campbell -o "$out/p5_campbell.csv" --chart "$out/p5_campbell.svg" > /dev/null
 
 for w in 1.0 2.0; do
     "$mbd" run models/windmill.mbd --set Omega_bar=$w --every 10 -o "$out/p5_windmill_$w.csv"

@@ -209,7 +209,12 @@ pub fn create_outputs<'a>(
 /// Renders a chart into its file (PNG for a `.png` name, else SVG); a failure is reported, not
 /// fatal (the CSV is written).
 pub fn draw(path: &str, file: &mut std::fs::File, chart: &mbd::output::charts::Chart) {
-    match mbd::output::charts::encode(std::slice::from_ref(chart), path) {
+    draw_panels(path, file, std::slice::from_ref(chart));
+}
+
+/// [`draw`] for panels stacked over one axis.
+pub fn draw_panels(path: &str, file: &mut std::fs::File, charts: &[mbd::output::charts::Chart]) {
+    match mbd::output::charts::encode(charts, path) {
         Ok(bytes) => {
             if let Err(e) = file.write_all(&bytes) {
                 eprintln!("error: cannot write chart file `{path}`: {e}");

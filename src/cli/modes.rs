@@ -4,8 +4,8 @@
 use super::progress::Evaluations;
 use super::swept::Swept;
 use super::{
-    compile, create_outputs, draw, exit_unless_failed, read_as, report, sink, to_path, usage,
-    Format, Jobs, EXIT_MODEL, EXIT_RUNTIME,
+    compile, create_outputs, draw_panels, exit_unless_failed, read_as, report, sink, to_path,
+    usage, Format, Jobs, EXIT_MODEL, EXIT_RUNTIME,
 };
 use mbd::settings::Request;
 use mbd::solve::modes::{Frame, Modes};
@@ -34,9 +34,10 @@ scaled so that its largest entry is 1).
 --sweep NAME=START:STOP:STEP (units allowed: Omega=200rpm:400rpm:100rpm) takes the modes at \
 every value (in parallel) and follows each mode by its shape; -o gets \
 NAME,mode,frequency_hz,omega_rad_s,damping_ratio,real_per_s,imag_rad_s,frame,rotor_speed_rad_s \
-(NAME in SI; mode is the followed mode's number), --chart a fan plot: each mode's natural \
-frequency against the param, with the per-revolution lines n Omega of the rotor speed. A value \
-that fails keeps a row of empty cells, and the exit code is 3.
+(NAME in SI; mode is the followed mode's number), --chart a Campbell diagram: each mode's \
+natural frequency against the param, with the per-revolution lines n Omega of the rotor speed, \
+and below it each mode's real part, the ranges where a mode grows shaded. A value that fails \
+keeps a row of empty cells, and the exit code is 3.
 
 Examples:
   mbd modes models/cantilever.mbd
@@ -197,10 +198,13 @@ fn sweep(a: &ModesArgs, text: &str, spec: &str) -> ExitCode {
         return usage(&format!("cannot write `{output}`: {e}"));
     }
     if let Some((p, f)) = chart.as_mut() {
-        let title = format!("{}: natural frequencies against {param}", c.model.name);
-        let mut chart = result.chart(&title);
-        chart.x_label = mbd::param_label(&c, &param);
-        draw(p, f, &chart);
+        let title = format!("{}: Campbell diagram against {param}", c.model.name);
+        let mut panels = result.chart(&title);
+        let label = mbd::param_label(&c, &param);
+        for panel in &mut panels {
+            panel.x_label.clone_from(&label);
+        }
+        draw_panels(p, f, &panels);
     }
     let mut failed = false;
     for p in &result.points {

@@ -4,7 +4,9 @@
 
 use super::progress::Evaluations;
 use super::swept::Swept;
-use super::{create_outputs, draw, exit_unless_failed, read, say, short, usage, Format, Jobs};
+use super::{
+    create_outputs, draw_panels, exit_unless_failed, read, say, short, usage, Format, Jobs,
+};
 use mbd::output::charts::Series;
 use mbd::solve::floquet::Monodromy;
 use mbd::study::sweep::{self, Method, SweepSpec};
@@ -44,12 +46,19 @@ the edge is bisected --refine times.
 
 The CSV has the columns PARAM,max_real,min_damping_ratio,method, then freq1,real1,freq2,\
 real2,... (rad/s and 1/s, modes by decreasing real part, conjugates once with freq >= 0; \
-empty cells where a point failed). The chart plots the real parts against the param, the \
-largest as a line, with the unstable ranges shaded; --reference FILE.csv adds the columns of \
-a CSV (its first column the param) as lines.
+empty cells where a point failed), then mode1_freq,mode1_real,mode1_damping,...: the modes \
+followed along the grid (per method), a stable column per mode: each mode continues the one \
+of the previous value whose shape it matches best (the modal assurance criterion; Prony's \
+poles, which have no shape, by the nearest exponent). --chart-kind real (the default) plots \
+the real parts against the param, the largest as a line, with the unstable ranges shaded; \
+--chart-kind campbell the Campbell diagram: each followed mode's frequency with the \
+per-revolution lines n Omega, and below it its real part, the unstable ranges shaded. \
+--reference FILE.csv adds the columns of a CSV (its first column the param) as lines on the \
+real parts.
 
 Examples:
   mbd stability models/windmill.mbd --sweep Omega_bar=0.8:2.6:0.05 -o stab.csv --chart stab.svg
+  mbd stability models/windmill.mbd --sweep Omega_bar=0.8:2.6:0.05 -o stab.csv --chart campbell.svg --chart-kind campbell
   mbd stability models/windmill.mbd --sweep Omega_bar=1.0:2.5:0.5 --method both --set blades=3 -o stab.csv";
 
 #[derive(clap::Args)]
@@ -96,6 +105,16 @@ pub struct StabilityArgs {
     /// Write the chart here (PNG for a `.png` name, else SVG).
     #[arg(long, value_name = "STAB.svg")]
     chart: Option<String>,
+    /// The chart: the real parts of every mode (real), or the Campbell diagram of the followed
+    /// modes, frequency with the per-rev lines above their real parts (campbell).
+    #[arg(long, value_enum, default_value = "real")]
+    chart_kind: ChartKind,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum ChartKind {
+    Real,
+    Campbell,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -167,10 +186,21 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         return usage(&format!("cannot write `{}`: {e}", a.output));
     }
     if let Some((p, f)) = chart_file.as_mut() {
-        let title = format!("{}: growth rates Re s against {}", c.model.name, spec.param);
-        let mut chart = result.chart(&title, reference);
-        chart.x_label = mbd::param_label(&c, &spec.param);
-        draw(p, f, &chart);
+        let mut panels = match a.chart_kind {
+            ChartKind::Real => {
+                let title = format!("{}: growth rates Re s against {}", c.model.name, spec.param);
+                vec![result.chart(&title, reference)]
+            }
+            ChartKind::Campbell => {
+                let title = format!("{}: Campbell diagram against {}", c.model.name, spec.param);
+                result.campbell(&title, reference)
+            }
+        };
+        let label = mbd::param_label(&c, &spec.param);
+        for panel in &mut panels {
+            panel.x_label.clone_from(&label);
+        }
+        draw_panels(p, f, &panels);
     }
     print_report(&result);
     exit_unless_failed(result.points.iter().any(|p| p.failure.is_some()))

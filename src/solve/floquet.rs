@@ -75,6 +75,10 @@ pub struct Floquet {
     /// history over the period (THEORY §9.2 step 4): `Im s + l 2 pi / T`. From perturbed
     /// runs, which keep no history, the principal branch's.
     pub frequencies: Vec<f64>,
+    /// Each mode's shape at the start (in the multipliers' order): the weighted displacements
+    /// of the free coordinates, then their weighted rates over `2 pi / T`; what a sweep
+    /// follows its modes by.
+    pub shapes: Vec<Vec<c64>>,
     /// Newton iterations over all runs.
     pub newton_iterations: usize,
     /// How the monodromy matrix was built.
@@ -236,6 +240,22 @@ impl Space {
         )
     }
 
+    /// A mode's shape at the start from its eigenvector `v` (`2 r` entries): the free
+    /// coordinates' weighted displacements, then their weighted rates over `Omega`.
+    fn shape(&self, v: &[(f64, f64)]) -> Vec<c64> {
+        let nfree = self.free.len();
+        let mut out = vec![c64::new(0.0, 0.0); 2 * nfree];
+        for (c, col) in self.basis.chunks(nfree).enumerate() {
+            for (half, x) in [(0, v[c]), (nfree, v[self.r + c])] {
+                for (o, b) in out[half..half + nfree].iter_mut().zip(col) {
+                    o.re += b * x.0;
+                    o.im += b * x.1;
+                }
+            }
+        }
+        out
+    }
+
     fn perturbed(&self, sys: &System, dir: usize, eps: f64) -> State {
         perturbed(
             sys,
@@ -319,6 +339,7 @@ pub fn floquet_by(
         })
     })?;
     let multipliers: Vec<c64> = modes.iter().map(|(m, _)| *m).collect();
+    let shapes = modes.iter().map(|(_, v)| space.shape(v)).collect();
     let exponents: Vec<c64> = multipliers.iter().map(|&m| exponent(m, period)).collect();
     let principal = || exponents.iter().map(|s| s.im).collect();
     let frequencies = if history.len() > 2 {
@@ -340,6 +361,7 @@ pub fn floquet_by(
         multipliers,
         exponents,
         frequencies,
+        shapes,
         newton_iterations,
         how,
     })

@@ -5,12 +5,13 @@
 //! worker of [`super::parallel`] and takes its modes with [`crate::modes`]; a point that fails
 //! (compile time, run time, or E0605 when the model has no steady motion there) keeps its row
 //! with the message. Modes are followed across the points by their shapes: each mode continues
-//! the track whose last shape it matches best (the modal assurance criterion), so a track keeps
-//! its mode where frequencies cross. Must not read or write files.
+//! the track whose last shape it matches best ([`super::tracking`]), so a track keeps its mode
+//! where frequencies cross. Must not read or write files.
 
 use super::parallel;
 use super::sweep::{CompileWith, PointError, Tick};
-use crate::output::charts::{Chart, Series};
+use super::tracking::{campbell, Column, Tracker};
+use crate::output::charts::Chart;
 use crate::solve::modes::{c64, Mode};
 use std::fmt::Display;
 use std::io::{self, Write};
@@ -46,25 +47,6 @@ pub struct Fan {
     pub tracks: usize,
 }
 
-/// The modal assurance criterion `|a^H b|^2 / (|a|^2 |b|^2)` of two shapes.
-fn mac(a: &[c64], b: &[c64]) -> f64 {
-    if a.len() != b.len() {
-        return 0.0;
-    }
-    let (mut re, mut im, mut na, mut nb) = (0.0, 0.0, 0.0, 0.0);
-    for (x, y) in a.iter().zip(b) {
-        re += x.re * y.re + x.im * y.im;
-        im += x.re * y.im - x.im * y.re;
-        na += x.re * x.re + x.im * x.im;
-        nb += y.re * y.re + y.im * y.im;
-    }
-    if na == 0.0 || nb == 0.0 {
-        0.0
-    } else {
-        (re * re + im * im) / (na * nb)
-    }
-}
-
 /// Runs the sweep (points in parallel) and follows the modes across it.
 pub fn fan<E: Display>(
     spec: &FanSpec,
@@ -90,8 +72,7 @@ pub fn fan<E: Display>(
         result
     });
     let mut points = Vec::new();
-    // The last shape of each track.
-    let mut last: Vec<Vec<c64>> = Vec::new();
+    let mut tracker = Tracker::new();
     for (k, r) in raw.into_iter().enumerate() {
         let value = spec.values[k];
         let r = r.unwrap_or(Err(PointError::Internal));
@@ -109,36 +90,11 @@ pub fn fan<E: Display>(
             }
         };
         let modes: Vec<Mode> = m.modes.into_iter().take(spec.count).collect();
-        // Greedy assignment by decreasing MAC; a mode matching no track well starts one.
-        let mut pairs: Vec<(f64, usize, usize)> = Vec::new();
-        for (i, md) in modes.iter().enumerate() {
-            for (t, s) in last.iter().enumerate() {
-                pairs.push((mac(&md.shape, s), i, t));
-            }
-        }
-        pairs.sort_by(|a, b| b.0.total_cmp(&a.0));
-        let mut track = vec![usize::MAX; modes.len()];
-        let mut taken = vec![false; last.len()];
-        for (v, i, t) in pairs {
-            if v >= 0.5 && track[i] == usize::MAX && !taken[t] {
-                track[i] = t;
-                taken[t] = true;
-            }
-        }
-        let mut out = Vec::new();
-        for (i, md) in modes.into_iter().enumerate() {
-            let t = if track[i] == usize::MAX {
-                last.push(Vec::new());
-                last.len() - 1
-            } else {
-                track[i]
-            };
-            last[t].clone_from(&md.shape);
-            out.push((t, md));
-        }
+        let keys: Vec<(c64, &[c64])> = modes.iter().map(|md| (md.s, &md.shape[..])).collect();
+        let tracks = tracker.follow(&keys);
         points.push(FanPoint {
             value,
-            modes: out,
+            modes: tracks.into_iter().zip(modes).collect(),
             frame: m.frame.label(),
             rotor_speed: m.rotor_speed,
             failure: None,
@@ -147,7 +103,7 @@ pub fn fan<E: Display>(
     Fan {
         param: spec.param.clone(),
         points,
-        tracks: last.len(),
+        tracks: tracker.tracks(),
     }
 }
 
@@ -185,67 +141,59 @@ impl Fan {
         Ok(())
     }
 
-    /// Natural frequency (rad/s) of each mode against the param, one line per track, with the
-    /// per-revolution lines `n Omega` of the rotor speed where the model spins.
-    pub fn chart(&self, title: &str) -> Chart {
-        let mut series: Vec<Series> = (0..self.tracks)
-            .map(|t| Series {
-                label: format!("mode {}", t + 1),
-                points: self
-                    .points
+    /// The Campbell diagram (see [`campbell`]): each mode's natural frequency (rad/s)
+    /// against the param, one line per track, with the per-revolution lines `n Omega` of the
+    /// rotor speed where the model spins; below, the real parts, the ranges where a mode grows
+    /// shaded.
+    pub fn chart(&self, title: &str) -> Vec<Chart> {
+        let ok: Vec<&FanPoint> = self.points.iter().filter(|p| p.failure.is_none()).collect();
+        let columns: Vec<Column> = ok
+            .iter()
+            .map(|p| Column {
+                value: p.value,
+                rotor_speed: p.rotor_speed,
+                modes: p
+                    .modes
                     .iter()
-                    .flat_map(|p| {
-                        p.modes
-                            .iter()
-                            .filter(move |(k, _)| *k == t)
-                            .map(move |(_, m)| (p.value, m.omega()))
-                    })
+                    .map(|(t, m)| (*t, c64::new(m.s.re, m.omega())))
                     .collect(),
-                markers_only: false,
             })
             .collect();
-        let ok: Vec<&FanPoint> = self.points.iter().filter(|p| p.failure.is_none()).collect();
-        let top = ok
+        campbell(
+            title,
+            &self.param,
+            &columns,
+            self.tracks,
+            growing(&ok),
+            Vec::new(),
+        )
+    }
+}
+
+/// The ranges of the param over which some mode grows (`Re s` above `GROWING` of its
+/// modulus, round-off kept out), from the first to the last such point of each run of them.
+fn growing(points: &[&FanPoint]) -> Vec<(f64, f64)> {
+    let grows = |p: &FanPoint| {
+        p.modes
             .iter()
-            .flat_map(|p| p.modes.iter().map(|(_, m)| m.omega()))
-            .fold(0.0f64, f64::max);
-        let fastest = ok.iter().map(|p| p.rotor_speed).fold(0.0f64, f64::max);
-        if fastest > 0.0 && top > 0.0 {
-            let revs = ((top / fastest).ceil() as usize).clamp(1, 8);
-            for n in 1..=revs {
-                series.push(Series {
-                    label: format!("{n}/rev"),
-                    points: ok
-                        .iter()
-                        .map(|p| (p.value, n as f64 * p.rotor_speed))
-                        .collect(),
-                    markers_only: false,
-                });
+            .any(|(_, m)| m.s.re > GROWING * m.s.re.hypot(m.s.im).max(f64::MIN_POSITIVE))
+    };
+    let mut out: Vec<(f64, f64)> = Vec::new();
+    let mut open: Option<(f64, f64)> = None;
+    for p in points {
+        match (grows(p), open) {
+            (true, Some((a, _))) => open = Some((a, p.value)),
+            (true, None) => open = Some((p.value, p.value)),
+            (false, Some(r)) => {
+                out.push(r);
+                open = None;
             }
-        }
-        Chart {
-            title: title.to_string(),
-            x_label: self.param.clone(),
-            y_label: "natural frequency [rad/s]".to_string(),
-            log_x: false,
-            log_y: false,
-            series,
-            shaded: Vec::new(),
-            guides: Vec::new(),
+            (false, None) => {}
         }
     }
+    out.extend(open);
+    out
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn mac_is_one_for_scaled_shapes_and_zero_for_orthogonal_ones() {
-        let a = [c64::new(1.0, 0.0), c64::new(0.0, 2.0)];
-        let b = [c64::new(0.0, 3.0), c64::new(-6.0, 0.0)];
-        assert!((mac(&a, &b) - 1.0).abs() < 1e-15);
-        let c = [c64::new(2.0, 0.0), c64::new(0.0, -1.0)];
-        assert!(mac(&a, &c).abs() < 1e-15);
-    }
-}
+/// A mode grows when its real part exceeds this share of its modulus.
+const GROWING: f64 = 1e-6;

@@ -17,6 +17,7 @@ mod items;
 pub mod prony;
 pub mod stability;
 pub mod sweep;
+pub mod tracking;
 
 pub use compile_error::CompileError;
 pub use items::{parse_alphas, split_list, IntegratorItem, StepList, UsageError};

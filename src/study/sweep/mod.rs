@@ -12,6 +12,7 @@
 
 mod point;
 mod range;
+mod tracks;
 
 pub use point::{default_signals, rotor_period, PeriodError, PointError};
 pub use range::{grid, parse_range, split_range, RangeError, MAX_POINTS};
@@ -83,6 +84,13 @@ pub struct Point {
     pub method: Method,
     /// One per mode: `Im s >= 0` (conjugates merged), largest real part first.
     pub modes: Vec<c64>,
+    /// Each mode's shape (Floquet: at the start, see [`crate::solve::floquet::Floquet`];
+    /// Prony: none, empty).
+    pub shapes: Vec<Vec<c64>>,
+    /// Each mode's track along the grid (0-based, per method; empty off the grid).
+    pub tracks: Vec<usize>,
+    /// The rotor speed (rad/s) of the per-rev lines; NaN when the model has none.
+    pub rotor_speed: f64,
     pub failure: Option<PointError>,
     pub cpu_s: f64,
     /// Floquet: the free coordinates and steps per period; Prony: poles kept and the sample
@@ -144,13 +152,15 @@ pub struct Sweep {
     pub notes: Vec<String>,
 }
 
-/// Runs the sweep: the grid in parallel, then each edge's bisection (edges in parallel).
+/// Runs the sweep: the grid in parallel, its modes followed along it, then each edge's
+/// bisection (edges in parallel).
 pub fn sweep<E: Display>(
     spec: &SweepSpec,
     compile: &CompileWith<E>,
     tick: &(dyn Fn(Tick) + Sync),
 ) -> Sweep {
-    let points = grid_points(spec, compile, tick);
+    let mut points = grid_points(spec, compile, tick);
+    tracks::follow(&mut points);
     let Some(&primary) = spec.methods.first() else {
         return Sweep {
             param: spec.param.clone(),
@@ -208,6 +218,9 @@ fn grid_points<E: Display>(
             value: jobs[k].0,
             method: jobs[k].1,
             modes: Vec::new(),
+            shapes: Vec::new(),
+            tracks: Vec::new(),
+            rotor_speed: f64::NAN,
             failure: Some(PointError::Internal),
             cpu_s: f64::NAN,
             detail: String::new(),
@@ -288,12 +301,18 @@ fn bisect<E: Display>(
 impl Sweep {
     /// The CSV: `PARAM,max_real,min_damping_ratio,method,freq1,real1,freq2,real2,...` (one row
     /// per grid value and method; frequencies in rad/s, real parts in 1/s, modes by decreasing
-    /// real part; empty cells where a point failed or has fewer modes).
+    /// real part; empty cells where a point failed or has fewer modes), then
+    /// `mode1_freq,mode1_real,mode1_damping,...`: the same modes by their track, a column per
+    /// followed mode (damping ratio `-Re s / |s|`).
     pub fn write_csv(&self, out: &mut dyn Write) -> io::Result<()> {
         let width = self.points.iter().map(|p| p.modes.len()).max().unwrap_or(0);
+        let tracks = tracks::count(&self.points);
         write!(out, "{},max_real,min_damping_ratio,method", self.param)?;
         for k in 1..=width {
             write!(out, ",freq{k},real{k}")?;
+        }
+        for k in 1..=tracks {
+            write!(out, ",mode{k}_freq,mode{k}_real,mode{k}_damping")?;
         }
         writeln!(out)?;
         for p in &self.points {
@@ -312,6 +331,7 @@ impl Sweep {
                     _ => write!(out, ",,")?,
                 }
             }
+            tracks::write_row(p, tracks, out)?;
             writeln!(out)?;
         }
         Ok(())

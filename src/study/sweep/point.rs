@@ -173,6 +173,9 @@ pub(super) fn evaluate<E: fmt::Display>(
         value,
         method,
         modes: Vec::new(),
+        shapes: Vec::new(),
+        tracks: Vec::new(),
+        rotor_speed: f64::NAN,
         failure: None,
         cpu_s: f64::NAN,
         detail: String::new(),
@@ -187,9 +190,10 @@ pub(super) fn evaluate<E: fmt::Display>(
             };
             point.cpu_s = thread_cpu_seconds() - start;
             match result {
-                Ok((modes, detail)) => {
-                    point.modes = modes;
-                    point.detail = detail;
+                Ok(found) => {
+                    (point.modes, point.shapes) = found.modes.into_iter().unzip();
+                    point.rotor_speed = found.rotor_speed;
+                    point.detail = found.detail;
                 }
                 Err(e) => point.failure = Some(e),
             }
@@ -215,11 +219,12 @@ fn summary(spec: &SweepSpec, point: &Point) -> String {
     }
 }
 
-/// Exponents with `Im s >= 0`, conjugates merged, largest real part first.
-fn modes_of(exponents: &[c64]) -> Vec<c64> {
-    let mut out: Vec<c64> = Vec::new();
+/// Exponents with `Im s >= 0`, conjugates merged, largest real part first, each with its
+/// shape (conjugated with a negative `Im s`; empty when unknown).
+fn modes_of(exponents: &[(c64, Vec<c64>)]) -> Vec<(c64, Vec<c64>)> {
+    let mut out: Vec<(c64, Vec<c64>)> = Vec::new();
     let mut taken = vec![false; exponents.len()];
-    for (i, s) in exponents.iter().enumerate() {
+    for (i, (s, shape)) in exponents.iter().enumerate() {
         if taken[i] {
             continue;
         }
@@ -227,22 +232,34 @@ fn modes_of(exponents: &[c64]) -> Vec<c64> {
         let scale = (s.re * s.re + s.im * s.im).sqrt().max(1e-12);
         // Its conjugate, if present.
         if let Some(j) = (0..exponents.len()).find(|&j| {
+            let o = exponents[j].0;
             !taken[j]
-                && (exponents[j].re - s.re).abs() <= 1e-8 * scale
-                && (exponents[j].im + s.im).abs() <= 1e-8 * scale
+                && (o.re - s.re).abs() <= 1e-8 * scale
+                && (o.im + s.im).abs() <= 1e-8 * scale
                 && s.im != 0.0
         }) {
             taken[j] = true;
         }
-        out.push(c64::new(s.re, s.im.abs()));
+        let shape = if s.im < 0.0 {
+            shape.iter().map(|x| c64::new(x.re, -x.im)).collect()
+        } else {
+            shape.clone()
+        };
+        out.push((c64::new(s.re, s.im.abs()), shape));
     }
-    out.sort_by(|a, b| b.re.total_cmp(&a.re));
+    out.sort_by(|a, b| b.0.re.total_cmp(&a.0.re));
     out
 }
 
-type Found = Result<(Vec<c64>, String), PointError>;
+/// What an evaluation found: the modes (exponent and shape, largest real part first), the
+/// rotor speed (rad/s; NaN without one) and the detail line.
+struct Found {
+    modes: Vec<(c64, Vec<c64>)>,
+    rotor_speed: f64,
+    detail: String,
+}
 
-fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Found {
+fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Result<Found, PointError> {
     let l = c
         .lowered
         .as_ref()
@@ -262,16 +279,18 @@ fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Found {
         },
     )?;
     // The frequencies resolved by each mode's dominant harmonic (THEORY §9.2 step 4).
-    let resolved: Vec<c64> = (f.exponents.iter().zip(&f.frequencies))
-        .map(|(s, &w)| c64::new(s.re, w))
+    let resolved: Vec<(c64, Vec<c64>)> = (f.exponents.iter().zip(&f.frequencies))
+        .zip(f.shapes)
+        .map(|((s, &w), shape)| (c64::new(s.re, w), shape))
         .collect();
-    Ok((
-        modes_of(&resolved),
-        format!(
+    Ok(Found {
+        modes: modes_of(&resolved),
+        rotor_speed: std::f64::consts::TAU / period,
+        detail: format!(
             "{} free coordinates, {} steps of {:.4e} s per period {:.6} s",
             f.free, f.steps, f.dt, f.period
         ),
-    ))
+    })
 }
 
 /// The columns of a decimated transient that Prony fits.
@@ -284,7 +303,8 @@ struct Transient {
     window: (f64, f64),
 }
 
-fn prony_point(spec: &SweepSpec, c: Compiled) -> Found {
+fn prony_point(spec: &SweepSpec, c: Compiled) -> Result<Found, PointError> {
+    let rotor_speed = rotor_period(&c).map_or(f64::NAN, |t| std::f64::consts::TAU / t);
     let t = transient(spec, c)?;
     let (from, to) = t.window;
     let poles = matrix_pencil(&t.signals, Some(&t.groups), t.step, &PencilSpec::default())
@@ -296,18 +316,19 @@ fn prony_point(spec: &SweepSpec, c: Compiled) -> Found {
             to,
         });
     }
-    let mut modes: Vec<c64> = poles.iter().map(|p| p.s).collect();
-    modes.sort_by(|a, b| b.re.total_cmp(&a.re));
-    Ok((
+    let mut modes: Vec<(c64, Vec<c64>)> = poles.iter().map(|p| (p.s, Vec::new())).collect();
+    modes.sort_by(|a, b| b.0.re.total_cmp(&a.0.re));
+    Ok(Found {
         modes,
-        format!(
+        rotor_speed,
+        detail: format!(
             "{} poles from {} signals, {} samples every {:.4e} s over {from:.3}..{to:.3} s",
             poles.len(),
             t.signals.len(),
             t.samples,
             t.step
         ),
-    ))
+    })
 }
 
 /// Runs the model to the window's end, written about `spec.samples` times over the window,
@@ -407,10 +428,15 @@ mod tests {
             c64::new(0.5, -1.0),
             c64::new(-3.0, 0.0),
         ];
-        let m = modes_of(&e);
+        let shaped: Vec<(c64, Vec<c64>)> = e.iter().map(|&s| (s, vec![s])).collect();
+        let m = modes_of(&shaped);
+        let exponents: Vec<c64> = m.iter().map(|x| x.0).collect();
         assert_eq!(
-            m,
+            exponents,
             vec![c64::new(0.5, 1.0), c64::new(-0.1, 2.0), c64::new(-3.0, 0.0)]
         );
+        // Each keeps its own shape, conjugated where the kept exponent was the lower one.
+        assert_eq!(m[0].1, vec![c64::new(0.5, 1.0)]);
+        assert_eq!(m[1].1, vec![c64::new(-0.1, 2.0)]);
     }
 }
