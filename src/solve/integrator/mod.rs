@@ -441,7 +441,7 @@ impl<'s> Integrator<'s> {
             .factor(&self.asm.values)
             .map_err(|e| self.singular(e))?;
         self.stats.factorizations += 1;
-        if self.set.newton != NewtonMode::Full {
+        if self.reuse.mode() != NewtonMode::Full {
             self.kept = Some(h);
         }
         Ok(())

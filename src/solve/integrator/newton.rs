@@ -175,6 +175,11 @@ impl Reuse {
         }
     }
 
+    /// The mode in force (`auto` is `full` for statics).
+    pub(super) fn mode(&self) -> NewtonMode {
+        self.mode
+    }
+
     /// The slowest contraction at which the step about to be taken uses a kept matrix again.
     pub(super) fn begin(&mut self) -> f64 {
         self.keeping = match self.mode {

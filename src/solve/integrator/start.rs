@@ -3,6 +3,7 @@
 //! paper's start), all from the constrained mass matrix of [`super::start_matrix`]; the
 //! state leaves in the layout of the integrator's rotation treatment.
 
+use super::newton::Reuse;
 use super::start_matrix::StartMetric;
 use super::{rotations, se3};
 use super::{Integrator, Layout, StepFailure};
@@ -116,6 +117,7 @@ impl Integrator<'_> {
         self.trial.clone_from(initial);
         self.mid.clone_from(initial);
         self.tracked = None;
+        self.reuse = Reuse::new(self.set.newton, self.set.method);
         self.stats = RunStats::default();
         self.step_index = 0;
         self.aug = self.scaling(self.set.dt);

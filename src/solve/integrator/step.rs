@@ -127,7 +127,7 @@ impl Integrator<'_> {
                     detail,
                 });
             }
-            let keep = if self.set.newton == NewtonMode::Full {
+            let keep = if self.reuse.mode() == NewtonMode::Full {
                 self.rigid && newton.quadratic()
             } else {
                 self.kept == Some(h) && newton.rate() <= keep_rate

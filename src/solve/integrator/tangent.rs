@@ -110,6 +110,38 @@ pub(super) fn perturb(
     }
 }
 
+/// [`perturb`] along a direction of the rates alone (its positions zero), into an `out` that
+/// already holds `base`'s positions: only the rates are written, the frames not displaced.
+fn perturb_rates(
+    sys: &System,
+    in_frame: &[bool],
+    base: &State,
+    dir: &[f64],
+    eps: f64,
+    out: &mut State,
+) {
+    let n = sys.len();
+    for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
+        out.v[i] = base.v[i] + eps * dir[n + i];
+        out.a[i] = base.a[i] + eps * dir[2 * n + i];
+        out.alg[i] = base.alg[i] + eps * dir[3 * n + i];
+    }
+    for k in 0..sys.rotations.len() {
+        let (b, f) = (&base.frames[k], &mut out.frames[k]);
+        for j in 0..6 {
+            (f.v[j], f.dv[j], f.alg[j]) = match slot(sys, k, j) {
+                Some(s) => (
+                    b.v[j] + eps * dir[n + s],
+                    b.dv[j] + eps * dir[2 * n + s],
+                    b.alg[j] + eps * dir[3 * n + s],
+                ),
+                None => (b.v[j], b.dv[j], b.alg[j]),
+            };
+        }
+        se3::to_physical(sys, out, k);
+    }
+}
+
 /// `out = a (-) b`, the direction that [`perturb`] takes from `b` to `a` (to first order).
 pub(super) fn difference(sys: &System, in_frame: &[bool], a: &State, b: &State, out: &mut [f64]) {
     let n = sys.len();
@@ -184,11 +216,10 @@ impl Integrator<'_> {
                 _ => 1.0,
             })
             .collect();
-        // Each step ends with the matrix factored at its converged state, which the next
-        // step's Newton keeps while it contracts (its first matrix costs nothing then).
-        if self.set.newton != NewtonMode::Full {
-            self.reuse = Reuse::new(NewtonMode::Modified, self.method);
-        }
+        // Each step ends with the matrix factored exactly at its converged state, which the
+        // next step's Newton keeps while it contracts (its first matrix costs nothing then),
+        // whatever the settings' mode: the step converges to the same tolerance either way.
+        self.reuse = Reuse::new(NewtonMode::Modified, self.method);
         self.tracked = Some(Box::new(Tracked {
             columns,
             count,
@@ -349,6 +380,8 @@ impl Integrator<'_> {
         self.node_maps(&mut tk.nodes);
         let coef = self.coefficients(h);
         tk.gradients.iter_mut().for_each(|x| *x = 0.0);
+        // The perturbed states below differ from the end's in their rates alone.
+        self.trial.assign(&self.cur);
         for c in 0..tk.count {
             tk.dir.copy_from_slice(&tk.columns[c * dim..(c + 1) * dim]);
             let moved = &mut tk.columns[c * dim..(c + 1) * dim];
@@ -370,7 +403,7 @@ impl Integrator<'_> {
             let eps = EPSILON / size;
             let gradient = &mut tk.gradients[c * n..(c + 1) * n];
             for sign in [1.0, -1.0] {
-                perturb(
+                perturb_rates(
                     self.sys,
                     &self.in_frame,
                     &self.cur,
