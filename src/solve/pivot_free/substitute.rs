@@ -3,6 +3,9 @@
 
 use super::PivotFree;
 
+/// Right-hand sides updated together by [`PivotFree::substitute_many`].
+const LANES: usize = 4;
+
 impl PivotFree {
     /// `rhs <- U^-1 L^-1 rhs`, in the original numbering.
     pub fn substitute(&mut self, rhs: &mut [f64]) {
@@ -71,24 +74,40 @@ impl PivotFree {
     }
 
     /// `rhs <- U^-1 L^-1 rhs` for `count` right-hand sides at once (column-major `n x count`):
-    /// each supernode's entries are read once for all of them. The workspace grows on the
-    /// first call of a size and is kept.
+    /// each supernode's entries are read once for every [`LANES`] of them, which are updated
+    /// together as fixed-size rows (unrolled and vectorised). The workspace grows on the first
+    /// call and is kept.
     pub fn substitute_many(&mut self, rhs: &mut [f64], count: usize) {
         let n = self.perm.len();
-        if count == 0 {
-            return;
+        let mut done = 0;
+        while done < count {
+            let lanes = (count - done).min(LANES);
+            let cols = &mut rhs[done * n..(done + lanes) * n];
+            match lanes {
+                4 => self.substitute_lanes::<4>(cols),
+                3 => self.substitute_lanes::<3>(cols),
+                2 => self.substitute_lanes::<2>(cols),
+                _ => self.substitute_lanes::<1>(cols),
+            }
+            done += lanes;
         }
-        if self.many.0.len() < n * count {
-            self.many.0.resize(n * count, 0.0);
+    }
+
+    /// [`PivotFree::substitute_many`] for `B` right-hand sides (column-major `n x B`).
+    fn substitute_lanes<const B: usize>(&mut self, rhs: &mut [f64]) {
+        let n = self.perm.len();
+        if self.many.0.len() < n * B {
+            self.many.0.resize(n * B, 0.0);
         }
-        if self.many.1.len() < self.gather.len() * count {
-            self.many.1.resize(self.gather.len() * count, 0.0);
+        if self.many.1.len() < self.gather.len() * B {
+            self.many.1.resize(self.gather.len() * B, 0.0);
         }
-        let (y, g) = (&mut self.many.0, &mut self.many.1);
         // Row-major: unknown k's right-hand sides side by side.
+        let (y, _) = self.many.0[..n * B].as_chunks_mut::<B>();
+        let (g, _) = self.many.1.as_chunks_mut::<B>();
         for (k, &o) in self.perm.iter().enumerate() {
-            for c in 0..count {
-                y[k * count + c] = rhs[c * n + o];
+            for (c, yk) in y[k].iter_mut().enumerate() {
+                *yk = rhs[c * n + o];
             }
         }
         let ns = self.first.len() - 1;
@@ -98,27 +117,25 @@ impl PivotFree {
             let rows = &self.rows[self.rows_ptr[t]..self.rows_ptr[t + 1]];
             let (m, ld) = (rows.len(), w + rows.len());
             let l = &self.x[self.l_at[t]..self.l_at[t] + ld * w];
-            let g = &mut g[..m * count];
-            g.fill(0.0);
+            let g = &mut g[..m];
+            g.fill([0.0; B]);
             for k in 0..w {
                 let c = &l[k * ld..(k + 1) * ld];
-                let (head, tail) = y.split_at_mut((f + k + 1) * count);
-                let yk = &head[(f + k) * count..];
-                for i in k + 1..w {
-                    let yi = &mut tail[(i - k - 1) * count..(i - k) * count];
-                    for (a, b) in yi.iter_mut().zip(yk) {
-                        *a -= c[i] * b;
+                let yk = y[f + k];
+                for (yi, &ci) in y[f + k + 1..f + w].iter_mut().zip(&c[k + 1..w]) {
+                    for j in 0..B {
+                        yi[j] -= ci * yk[j];
                     }
                 }
-                for (gi, ci) in g.chunks_mut(count).zip(&c[w..]) {
-                    for (a, b) in gi.iter_mut().zip(yk) {
-                        *a += ci * b;
+                for (gi, &ci) in g.iter_mut().zip(&c[w..]) {
+                    for j in 0..B {
+                        gi[j] += ci * yk[j];
                     }
                 }
             }
-            for (&i, gi) in rows.iter().zip(g.chunks(count)) {
-                for (a, b) in y[i * count..(i + 1) * count].iter_mut().zip(gi) {
-                    *a -= b;
+            for (&i, gi) in rows.iter().zip(g.iter()) {
+                for j in 0..B {
+                    y[i][j] -= gi[j];
                 }
             }
         }
@@ -129,34 +146,34 @@ impl PivotFree {
             let (m, ld) = (rows.len(), w + rows.len());
             let l = &self.x[self.l_at[t]..self.l_at[t] + ld * w];
             let ut = &self.x[self.u_at[t]..self.u_at[t] + m * w];
-            let g = &mut g[..m * count];
-            for (gi, &i) in g.chunks_mut(count).zip(rows) {
-                gi.copy_from_slice(&y[i * count..(i + 1) * count]);
+            let g = &mut g[..m];
+            for (gi, &i) in g.iter_mut().zip(rows) {
+                *gi = y[i];
             }
             for j in 0..w {
-                let yj = &mut y[(f + j) * count..(f + j + 1) * count];
-                for (u, gi) in ut[j * m..(j + 1) * m].iter().zip(g.chunks(count)) {
-                    for (a, b) in yj.iter_mut().zip(gi) {
-                        *a -= u * b;
+                let yj = &mut y[f + j];
+                for (&u, gi) in ut[j * m..(j + 1) * m].iter().zip(g.iter()) {
+                    for c in 0..B {
+                        yj[c] -= u * gi[c];
                     }
                 }
             }
             for k in (0..w).rev() {
                 let d = l[k + k * ld];
-                let (head, tail) = y.split_at_mut((f + k) * count);
-                let yk = &mut tail[..count];
-                yk.iter_mut().for_each(|a| *a /= d);
-                for i in 0..k {
-                    let yi = &mut head[(f + i) * count..(f + i + 1) * count];
-                    for (a, b) in yi.iter_mut().zip(yk.iter()) {
-                        *a -= l[i + k * ld] * b;
+                for c in 0..B {
+                    y[f + k][c] /= d;
+                }
+                let yk = y[f + k];
+                for (yi, &lik) in y[f..f + k].iter_mut().zip(&l[k * ld..k * ld + k]) {
+                    for c in 0..B {
+                        yi[c] -= lik * yk[c];
                     }
                 }
             }
         }
         for (k, &o) in self.perm.iter().enumerate() {
-            for c in 0..count {
-                rhs[c * n + o] = y[k * count + c];
+            for (c, yk) in y[k].iter().enumerate() {
+                rhs[c * n + o] = *yk;
             }
         }
     }
