@@ -68,8 +68,13 @@ pub struct Assembler {
     /// Per element with inertia or damping: the frames among its unknowns, each with the
     /// local positions of its translation and rotation unknowns.
     rated: Rated,
-    /// The elements whose residual reads the rates ([`Element::reads_rates`]).
-    reading: Vec<usize>,
+    /// The elements whose residual reads the rates ([`Element::reads_rates`]): those with
+    /// inertia or damping, whose tangents split into `M` and `C` ([`Element::has_rates`]),
+    /// and the rest (joints with rate rows).
+    reading: (Vec<usize>, Vec<usize>),
+    /// Per element of `reading.0`, its local `M` then `C` (row-major, `nl x nl` each) at the
+    /// state of the last [`Assembler::rate_jacobians`]; sized on its first call.
+    rate_local: Vec<f64>,
     pub residual: Residual,
     /// Generalized momenta `P = M(q) V` and transport terms `G` (`dP/dt + G = F^I`).
     pub momentum: Vec<f64>,
@@ -108,7 +113,8 @@ impl Assembler {
             rated,
             reading: (0..sys.elements.len())
                 .filter(|&e| sys.elements[e].reads_rates())
-                .collect(),
+                .partition(|&e| sys.elements[e].has_rates()),
+            rate_local: Vec::new(),
             residual: Residual::new(n),
             momentum: vec![0.0; n],
             transport: vec![0.0; n],
@@ -202,12 +208,72 @@ impl Assembler {
         }
     }
 
-    /// The residual parts of the elements that read the rates alone: its difference between
-    /// two states of the same positions is the whole residual's.
-    pub fn rate_residual(&mut self, sys: &System, st: &State, aug: Augment) {
+    /// The residual parts of the elements that read the rates (`all`), or of those whose
+    /// derivatives are not in [`Assembler::rate_jacobians`] (joints with rate rows): its
+    /// difference between two states of the same positions is the whole residual's, or the
+    /// rest of it.
+    pub fn rate_residual(&mut self, sys: &System, st: &State, aug: Augment, all: bool) {
         self.residual.clear();
-        for &e in &self.reading {
+        let first: &[usize] = if all { &self.reading.0 } else { &[] };
+        for &e in first.iter().chain(&self.reading.1) {
             sys.elements[e].residual(st, aug, &mut self.residual);
+        }
+    }
+
+    /// Whether [`Assembler::rate_residual`] evaluates some element.
+    pub fn has_rate_residual(&self, all: bool) -> bool {
+        !self.reading.1.is_empty() || (all && !self.reading.0.is_empty())
+    }
+
+    /// The residual's derivatives with respect to the accelerations (`M`) and the velocities
+    /// (`C`) at a state, kept per element with inertia or damping for
+    /// [`Assembler::rate_product`] (their tangents' `mass` and `velocity` parts, as
+    /// [`Assembler::add_rate_columns`] takes them).
+    pub fn rate_jacobians(&mut self, sys: &System, st: &State, aug: Augment) {
+        let size: usize = (self.reading.0.iter())
+            .map(|&e| 2 * self.indices[e].len().pow(2))
+            .sum();
+        if self.rate_local.len() != size {
+            self.rate_local.resize(size, 0.0);
+        }
+        let rates = |mass: f64, velocity: f64| TangentCoeffs {
+            mass,
+            velocity,
+            position: 0.0,
+            force_weight: 1.0,
+        };
+        let mut at = 0;
+        for &e in &self.reading.0 {
+            let nl2 = self.indices[e].len().pow(2);
+            let (m, rest) = self.rate_local[at..at + 2 * nl2].split_at_mut(nl2);
+            sys.elements[e].tangent(st, aug, rates(1.0, 0.0), m);
+            sys.elements[e].tangent(st, aug, rates(0.0, 1.0), rest);
+            at += 2 * nl2;
+        }
+    }
+
+    /// `out += M da + C dv` with the derivatives of the last [`Assembler::rate_jacobians`]:
+    /// the residual's change along a change of the rates alone (velocities `dv` and
+    /// accelerations `da` as the state holds them: rotations' entries are angular velocities
+    /// and accelerations).
+    pub fn rate_product(&self, dv: &[f64], da: &[f64], out: &mut [f64]) {
+        let n = out.len();
+        let mut at = 0;
+        for &e in &self.reading.0 {
+            let idx = &self.indices[e];
+            let nl = idx.len();
+            let (m, c) = self.rate_local[at..at + 2 * nl * nl].split_at(nl * nl);
+            at += 2 * nl * nl;
+            for (i, &gi) in idx.iter().enumerate().filter(|&(_, &gi)| gi < n) {
+                let (mi, ci) = (&m[i * nl..(i + 1) * nl], &c[i * nl..(i + 1) * nl]);
+                let mut sum = 0.0;
+                for ((&gj, a), b) in idx.iter().zip(mi).zip(ci) {
+                    if gj < n {
+                        sum += a * da[gj] + b * dv[gj];
+                    }
+                }
+                out[gi] += sum;
+            }
         }
     }
 

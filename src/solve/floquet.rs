@@ -9,8 +9,10 @@
 //!    (rate rows included: a prescribed motion is not perturbed; a revolute's angle unknown
 //!    moves with its bodies), weighted so that translations count in units of the model's
 //!    length scale and rotations in radians. States are `z = (N0^T W^-1 dq, N0^T W^-1 dv / w)`
-//!    with `w = 2 pi / T`, of dimension `2 n_f`; rotations differ by
-//!    `axial log(R Rbar^T)` (spatial, as the perturbation `R <- exp(dtheta~) R`).
+//!    with `w = 2 pi / T`; rotations differ by `axial log(R Rbar^T)` (spatial, as the
+//!    perturbation `R <- exp(dtheta~) R`). Velocities only along the directions of `N0`
+//!    with inertia (`floquet/space.rs`: a beam node without rotary inertia has no velocity
+//!    state), so `z` has `n_f + n_m <= 2 n_f` entries.
 //! 3. Each state direction is perturbed by `+-eps` and made consistent the same way as the
 //!    reference (positions projected back onto the joints, velocities made tangent, consistent
 //!    accelerations): `Z_0`, the central differences of their measure.
@@ -40,15 +42,16 @@
 //! integrator's numerical damping (§7.4).
 
 mod harmonics;
+mod space;
 
-use super::integrator::{Integrator, Linearization};
-use super::linear::{generalized_eigen, null_space};
+use super::integrator::Integrator;
+use super::linear::generalized_eigen;
 use super::modes::c64;
 use super::{RuntimeFailure, Stop};
-use crate::runtime::rotation::{exp, log, V3};
-use crate::runtime::{State, System, UnknownKind};
+use crate::runtime::{State, System};
 use crate::settings::Settings;
 use nalgebra::DMatrix;
+use space::Space;
 use std::convert::Infallible;
 
 /// Relative size of the perturbations (of the length scale, of a radian).
@@ -62,9 +65,10 @@ pub struct Floquet {
     /// Steps per period and their size.
     pub steps: usize,
     pub dt: f64,
-    /// Dimension `n_f` of the constraint-free position space (the state has `2 n_f`).
+    /// Dimension `n_f` of the constraint-free position space (the state has `n_f + n_m`, `n_m`
+    /// its directions with inertia).
     pub free: usize,
-    /// The monodromy matrix, column-major `2 n_f x 2 n_f`.
+    /// The monodromy matrix, column-major over the state (`n_f + n_m` square).
     pub monodromy: Vec<f64>,
     /// Characteristic multipliers, largest modulus first.
     pub multipliers: Vec<c64>,
@@ -113,89 +117,6 @@ pub fn exponent(m: c64, t: f64) -> c64 {
     c64::new(r.ln() / t, m.im.atan2(m.re) / t)
 }
 
-/// Physical quantities of a state: per non-multiplier unknown, its position (coordinates) and
-/// its velocity (coordinates: the rate; rotations: the angular velocity component).
-fn rates(sys: &System, st: &State, i: usize) -> f64 {
-    match sys.unknowns[i] {
-        UnknownKind::Rotation { node, axis } => st.rot[node].w[axis],
-        _ => st.v[i],
-    }
-}
-
-/// The perturbation state `z` of `st` from `reference`, over the free unknowns.
-fn measure(
-    sys: &System,
-    st: &State,
-    reference: &State,
-    free: &[usize],
-    basis: &[f64],
-    weights: &[f64],
-    omega: f64,
-) -> Vec<f64> {
-    let nfree = free.len();
-    let r = basis.len() / nfree;
-    // Rotation differences per node.
-    let turns: Vec<V3> = (0..sys.rotations.len())
-        .map(|k| log(&(st.rot[k].matrix() * reference.rot[k].matrix().transpose())))
-        .collect();
-    let mut dq = vec![0.0; nfree];
-    let mut dv = vec![0.0; nfree];
-    for (j, &i) in free.iter().enumerate() {
-        dq[j] = match sys.unknowns[i] {
-            UnknownKind::Rotation { node, axis } => turns[node][axis],
-            _ => st.q[i] - reference.q[i],
-        } / weights[j];
-        dv[j] = (rates(sys, st, i) - rates(sys, reference, i)) / (weights[j] * omega);
-    }
-    let mut z = vec![0.0; 2 * r];
-    for c in 0..r {
-        let col = &basis[c * nfree..(c + 1) * nfree];
-        z[c] = col.iter().zip(&dq).map(|(a, b)| a * b).sum();
-        z[r + c] = col.iter().zip(&dv).map(|(a, b)| a * b).sum();
-    }
-    z
-}
-
-/// The model's initial state perturbed by `eps` along state direction `dir` (positions for
-/// `dir < r`, velocities otherwise).
-#[allow(clippy::too_many_arguments)]
-fn perturbed(
-    sys: &System,
-    free: &[usize],
-    basis: &[f64],
-    weights: &[f64],
-    omega: f64,
-    dir: usize,
-    eps: f64,
-) -> State {
-    let nfree = free.len();
-    let r = basis.len() / nfree;
-    let (col, velocity) = if dir < r {
-        (dir, false)
-    } else {
-        (dir - r, true)
-    };
-    let col = &basis[col * nfree..(col + 1) * nfree];
-    let mut st = sys.initial.clone();
-    let mut turns = vec![V3::zeros(); sys.rotations.len()];
-    for (j, &i) in free.iter().enumerate() {
-        let d = eps * weights[j] * col[j];
-        match (sys.unknowns[i], velocity) {
-            (UnknownKind::Rotation { node, axis }, false) => turns[node][axis] += d,
-            (UnknownKind::Rotation { node, axis }, true) => st.rot[node].w[axis] += d * omega,
-            (_, false) => st.q[i] += d,
-            (_, true) => st.v[i] += d * omega,
-        }
-    }
-    for (k, th) in turns.iter().enumerate() {
-        if th.norm() > 0.0 {
-            let m = exp(th) * st.rot[k].matrix();
-            st.rot[k].set_matrix(&m);
-        }
-    }
-    st
-}
-
 /// Integrates from the integrator's current (initialized) state over its settings' steps.
 fn integrate(it: &mut Integrator) -> Result<State, RuntimeFailure> {
     it.run(|_, _| Ok::<(), Infallible>(()))
@@ -212,61 +133,9 @@ pub enum Monodromy {
     /// From the step's own tangent carried along one run (the Newmark family with
     /// incremental rotations; other integrators fall back to [`Monodromy::Runs`]).
     Tangent,
-    /// From `4 n_f` perturbed runs of one period, by central differences (any integrator).
+    /// From two perturbed runs of one period per state direction, by central differences (any
+    /// integrator).
     Runs,
-}
-
-/// What the start of a Floquet analysis leaves: the integrator at the consistent reference
-/// start, and the perturbation space.
-struct Space {
-    free: Vec<usize>,
-    weights: Vec<f64>,
-    basis: Vec<f64>,
-    r: usize,
-    omega: f64,
-    start: State,
-}
-
-impl Space {
-    fn measure(&self, sys: &System, st: &State, reference: &State) -> Vec<f64> {
-        measure(
-            sys,
-            st,
-            reference,
-            &self.free,
-            &self.basis,
-            &self.weights,
-            self.omega,
-        )
-    }
-
-    /// A mode's shape at the start from its eigenvector `v` (`2 r` entries): the free
-    /// coordinates' weighted displacements, then their weighted rates over `Omega`.
-    fn shape(&self, v: &[(f64, f64)]) -> Vec<c64> {
-        let nfree = self.free.len();
-        let mut out = vec![c64::new(0.0, 0.0); 2 * nfree];
-        for (c, col) in self.basis.chunks(nfree).enumerate() {
-            for (half, x) in [(0, v[c]), (nfree, v[self.r + c])] {
-                for (o, b) in out[half..half + nfree].iter_mut().zip(col) {
-                    o.re += b * x.0;
-                    o.im += b * x.1;
-                }
-            }
-        }
-        out
-    }
-
-    fn perturbed(&self, sys: &System, dir: usize, eps: f64) -> State {
-        perturbed(
-            sys,
-            &self.free,
-            &self.basis,
-            &self.weights,
-            self.omega,
-            dir,
-            eps,
-        )
-    }
 }
 
 /// Floquet analysis of the model's motion over `period` seconds (THEORY §9.2), with the
@@ -295,15 +164,8 @@ pub fn floquet_by(
     let mut it = Integrator::new(sys, &set).map_err(reference_failure)?;
     it.initialize().map_err(reference_failure)?;
     let lin = it.linearize();
-    let (weights, basis, r) = perturbation_space(sys, &lin).map_err(reference_failure)?;
-    let space = Space {
-        free: lin.unknowns.clone(),
-        weights,
-        basis,
-        r,
-        omega: 2.0 * std::f64::consts::PI / period,
-        start: it.state().clone(),
-    };
+    let omega = 2.0 * std::f64::consts::PI / period;
+    let space = Space::new(sys, &lin, omega, it.state().clone()).map_err(reference_failure)?;
     let how = if it.can_track() { how } else { Monodromy::Runs };
     let Columns {
         z0,
@@ -314,7 +176,7 @@ pub fn floquet_by(
         Monodromy::Tangent => by_tangent(sys, &mut it, &space, progress)?,
         Monodromy::Runs => by_runs(sys, &mut it, &space, progress)?,
     };
-    let n = 2 * r;
+    let n = space.dim();
     let phi_m = match z0.clone().lu().solve(&DMatrix::<f64>::identity(n, n)) {
         Some(inv) => &zt * inv,
         None => {
@@ -356,7 +218,7 @@ pub fn floquet_by(
         period,
         steps,
         dt: h,
-        free: r,
+        free: space.r,
         monodromy: phi,
         multipliers,
         exponents,
@@ -387,7 +249,7 @@ fn starts<F>(
 where
     F: FnMut(&mut Integrator, usize, f64) -> Result<(), RuntimeFailure>,
 {
-    let n = 2 * space.r;
+    let n = space.dim();
     let mut z0 = DMatrix::<f64>::zeros(n, n);
     for dir in 0..n {
         for sign in [1.0, -1.0] {
@@ -416,7 +278,7 @@ fn by_tangent(
     progress: &dyn Fn(),
 ) -> Result<Columns, FloquetFailure> {
     let reference_failure = |failure| FloquetFailure { run: None, failure };
-    let n = 2 * space.r;
+    let n = space.dim();
     let dim = it.direction_len();
     let mut directions = vec![0.0; n * dim];
     let mut diff = vec![0.0; dim];
@@ -465,9 +327,15 @@ fn carried_measure(
     space: &Space,
     reference: &State,
 ) -> DMatrix<f64> {
-    let (n, dim) = (2 * space.r, it.direction_len());
+    let (n, dim, nfree) = (space.dim(), it.direction_len(), space.free.len());
     let carried = it.tracked().unwrap_or_default();
-    let mut zt = DMatrix::<f64>::zeros(n, n);
+    // Each direction's weighted displacements and rates, then projected all at once.
+    let (mut dq, mut dv) = (
+        DMatrix::<f64>::zeros(nfree, n),
+        DMatrix::<f64>::zeros(nfree, n),
+    );
+    let (mut bq, mut bv) = (vec![0.0; nfree], vec![0.0; nfree]);
+    let (mut cq, mut cv) = (vec![0.0; nfree], vec![0.0; nfree]);
     let mut st = reference.clone();
     for dir in 0..n {
         let col = &carried[dir * dim..(dir + 1) * dim];
@@ -483,14 +351,15 @@ fn carried_measure(
         }
         let e = 1e-6 / size;
         it.perturb_state(reference, col, e, &mut st);
-        let b = space.measure(sys, &st, reference);
+        space.displacements(sys, &st, reference, (&mut bq, &mut bv));
         it.perturb_state(reference, col, -e, &mut st);
-        let c = space.measure(sys, &st, reference);
-        for i in 0..n {
-            zt[(i, dir)] = (b[i] - c[i]) / (2.0 * e);
+        space.displacements(sys, &st, reference, (&mut cq, &mut cv));
+        for j in 0..nfree {
+            dq[(j, dir)] = (bq[j] - cq[j]) / (2.0 * e);
+            dv[(j, dir)] = (bv[j] - cv[j]) / (2.0 * e);
         }
     }
-    zt
+    space.project(&dq, &dv)
 }
 
 /// The monodromy's columns from `4 n_f` perturbed runs of one period.
@@ -504,7 +373,7 @@ fn by_runs(
     let reference = integrate(it).map_err(reference_failure)?;
     progress();
     let mut newton_iterations = it.stats().newton_iterations;
-    let n = 2 * space.r;
+    let n = space.dim();
     // Each perturbed start integrated over the period (the projection onto the joints at the
     // start moves the dependent velocities of a position perturbation): Phi = Z_T Z_0^-1.
     let mut zt = DMatrix::<f64>::zeros(n, n);
@@ -524,39 +393,6 @@ fn by_runs(
         newton_iterations,
         history: Vec::new(),
     })
-}
-
-/// The weighted perturbation space: the weights of the free coordinates (translations in
-/// units of the length scale, rotations and angles in radians), the orthonormal basis of the
-/// null space of the weighted constraint gradient, and its dimension.
-fn perturbation_space(
-    sys: &System,
-    lin: &Linearization,
-) -> Result<(Vec<f64>, Vec<f64>, usize), RuntimeFailure> {
-    let nfree = lin.unknowns.len();
-    let angles = sys.angle_unknowns();
-    let weights: Vec<f64> = lin
-        .unknowns
-        .iter()
-        .map(|&i| match sys.unknowns[i] {
-            UnknownKind::Coordinate if !angles.contains(&i) => sys.length_scale,
-            _ => 1.0,
-        })
-        .collect();
-    let mut bw = lin.b.clone();
-    for row in 0..lin.rows {
-        for (j, w) in weights.iter().enumerate() {
-            bw[row * nfree + j] *= w;
-        }
-    }
-    let (basis, r) = null_space(&bw, lin.rows, nfree).ok_or_else(|| RuntimeFailure {
-        kind: super::FailureKind::Singular,
-        t: 0.0,
-        step: 0,
-        entity: None,
-        detail: "the singular value decomposition of the constraint gradient failed".into(),
-    })?;
-    Ok((weights, basis, r))
 }
 
 /// The eigenvalues of the `n x n` column-major matrix `phi` and their eigenvectors, by

@@ -4,7 +4,7 @@
 //! is `exp(s t) p(t)` with `p` periodic, and the frequency is the principal exponent's plus
 //! the dominant harmonic `l Omega` of `p`: the harmonic that carries most of the mode's motion.
 
-use nalgebra::{Complex, DMatrix, DVector};
+use nalgebra::{Complex, DMatrix};
 
 /// A mode: its exponent `(Re s, Im s)` on the principal branch and its eigenvector (complex
 /// entries as `(re, im)`).
@@ -28,27 +28,37 @@ pub fn resolve(
     let lu = z0.clone().lu();
     let omega = 2.0 * std::f64::consts::PI / period;
     let top = MAX_HARMONIC.min(history.len() as i32 / 2 - 1).max(0);
-    let mut out = Vec::with_capacity(modes.len());
-    for ((re, im), v) in modes {
-        let vr = DVector::from_iterator(v.len(), v.iter().map(|x| x.0));
-        let vi = DVector::from_iterator(v.len(), v.iter().map(|x| x.1));
-        let (wr, wi) = (lu.solve(&vr)?, lu.solve(&vi)?);
-        // c_l = sum_k exp(-s t_k) y(t_k) exp(-i l Omega t_k), per component.
-        let mut energy = vec![0.0f64; (2 * top + 1) as usize];
-        let mut c = vec![Complex::new(0.0, 0.0); v.len() * energy.len()];
-        for (t, z) in history {
-            let (yr, yi) = (z * &wr, z * &wi);
+    let (n, harmonics) = (z0.nrows(), (2 * top + 1) as usize);
+    // Every mode's start at once: `W = Z_0^-1 V`, real and imaginary parts.
+    let part = |pick: fn(&(f64, f64)) -> f64| {
+        DMatrix::from_fn(n, modes.len(), |i, m| modes[m].1.get(i).map_or(0.0, pick))
+    };
+    let (wr, wi) = (lu.solve(&part(|x| x.0))?, lu.solve(&part(|x| x.1))?);
+    // c_l = sum_k exp(-s t_k) y(t_k) exp(-i l Omega t_k), per mode, harmonic and component.
+    let mut c = vec![Complex::new(0.0, 0.0); modes.len() * harmonics * n];
+    for (t, z) in history {
+        let (yr, yi) = (z * &wr, z * &wi);
+        for (m, ((re, im), _)) in modes.iter().enumerate() {
             let back = Complex::new(-re * t, -im * t).exp();
-            for (l, cl) in (-top..=top).zip(c.chunks_mut(v.len())) {
+            let cm = &mut c[m * harmonics * n..(m + 1) * harmonics * n];
+            for (l, cl) in (-top..=top).zip(cm.chunks_mut(n)) {
                 let turn = back * Complex::new(0.0, -(l as f64) * omega * t).exp();
-                for (ci, (a, b)) in cl.iter_mut().zip(yr.iter().zip(yi.iter())) {
+                for (ci, (a, b)) in cl
+                    .iter_mut()
+                    .zip(yr.column(m).iter().zip(yi.column(m).iter()))
+                {
                     *ci += turn * Complex::new(*a, *b);
                 }
             }
         }
-        for (e, cl) in energy.iter_mut().zip(c.chunks(v.len())) {
-            *e = cl.iter().map(|x| x.norm_sqr()).sum();
-        }
+    }
+    let mut out = Vec::with_capacity(modes.len());
+    for (m, ((_, im), _)) in modes.iter().enumerate() {
+        let cm = &c[m * harmonics * n..(m + 1) * harmonics * n];
+        let energy: Vec<f64> = cm
+            .chunks(n)
+            .map(|cl| cl.iter().map(|x| x.norm_sqr()).sum())
+            .collect();
         // The dominant harmonic; the one nearest the principal branch among equals.
         let mut best = top as usize;
         for (k, e) in energy.iter().enumerate() {
