@@ -167,6 +167,19 @@ pub fn floquet_by(
     let omega = 2.0 * std::f64::consts::PI / period;
     let space = Space::new(sys, &lin, omega, it.state().clone()).map_err(reference_failure)?;
     let how = if it.can_track() { how } else { Monodromy::Runs };
+    if how == Monodromy::Runs && space.massless() > 0 {
+        return Err(reference_failure(RuntimeFailure {
+            kind: super::FailureKind::Unsupported,
+            t: 0.0,
+            step: 0,
+            entity: None,
+            detail: format!(
+                "{} of the model's {} free directions carry no inertia (beam nodes without rotary inertia), and the monodromy from perturbed runs is not reliable for them: a perturbation of one is not a state of the motion, and the first step's response to it is far from linear; use the step's tangent (--monodromy tangent, with HHT or generalized-alpha and incremental rotations) or give the sections rotary inertia",
+                space.massless(),
+                space.r
+            ),
+        }));
+    }
     let Columns {
         z0,
         zt,

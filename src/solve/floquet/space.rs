@@ -112,6 +112,11 @@ impl Space {
         })
     }
 
+    /// The directions of `N0` without inertia.
+    pub(super) fn massless(&self) -> usize {
+        self.r - self.rv
+    }
+
     /// The state's dimension: `n_f` positions, `n_m` velocities.
     pub(super) fn dim(&self) -> usize {
         self.r + self.rv
