@@ -1,4 +1,4 @@
-//! Issue 22 item 4: modes followed along a stability sweep, checked against the windmill's
+//! Issue 22 items 4 and 5: modes followed along a stability sweep, checked against the windmill's
 //! multiblade equations (`tests/mbc.rs`, independent of mbd). Through the ground-resonance
 //! band (Omega_bar 1.3 to 2.2) the regressive lag mode and the hub mode coalesce (one
 //! frequency, real parts of opposite sign) and that pair's frequency crosses the lag frequency
@@ -186,4 +186,56 @@ fn a_campbell_sweep_keeps_each_multiblade_mode_in_its_column() {
     ] {
         assert!(chart.contains(label), "{label}");
     }
+}
+
+/// Item 5: the sweep hands its rows out as the grid's points finish: every partial sweep's
+/// CSV is the final CSV's first rows (modes followed the same way), the runs grow, and the
+/// last one is the whole grid.
+#[test]
+fn a_sweep_streams_its_rows_as_its_points_finish() {
+    use mbd::study::sweep::{self, Method, SweepSpec};
+    use std::sync::Mutex;
+    let path = "models/windmill.mbd";
+    let source = crate::common::read(path);
+    let spec = SweepSpec {
+        monodromy: mbd::solve::floquet::Monodromy::Tangent,
+        param: "Omega_bar".to_string(),
+        values: vec![1.0, 1.1, 1.2, 1.3, 1.4],
+        methods: vec![Method::Floquet],
+        period: None,
+        signals: Vec::new(),
+        window: None,
+        samples: 300,
+        threshold: 1e-2,
+        refine: 0,
+    };
+    let compile = |extra: &[String]| {
+        mbd::compile(path, &source, extra, mbd::settings::Request::default())
+            .map_err(|f| format!("{:?}", f.diagnostics))
+    };
+    let csv = |s: &sweep::Sweep| {
+        let mut out = Vec::new();
+        s.write_csv(&mut out).expect("in memory");
+        String::from_utf8(out).expect("utf-8")
+    };
+    let partials = Mutex::new(Vec::new());
+    let result = sweep::sweep_streaming(&spec, &compile, &|_| {}, &|s| {
+        partials
+            .lock()
+            .expect("lock")
+            .push((s.points.len(), csv(s)));
+    });
+    let whole = csv(&result);
+    let partials = partials.into_inner().expect("lock");
+    assert!(!partials.is_empty());
+    let mut last = 0;
+    for (rows, text) in &partials {
+        assert!(*rows > last, "the runs grow: {rows} after {last}");
+        last = *rows;
+        assert_eq!(text.lines().count(), rows + 1);
+        for (a, b) in text.lines().zip(whole.lines()) {
+            assert_eq!(a, b);
+        }
+    }
+    assert_eq!(last, spec.values.len());
 }

@@ -11,7 +11,10 @@ use mbd::output::charts::Series;
 use mbd::solve::floquet::Monodromy;
 use mbd::study::sweep::{self, Method, SweepSpec};
 use mbd::Compiled;
+use std::io::{Seek, SeekFrom, Write};
 use std::process::ExitCode;
+use std::sync::Mutex;
+use std::time::{Duration, Instant};
 
 /// `mbd stability --help`.
 pub const LONG_ABOUT: &str = "\
@@ -56,7 +59,8 @@ the real parts against the param, the largest as a line, with the unstable range
 --chart-kind campbell the Campbell diagram: each followed mode's frequency with the \
 per-revolution lines n Omega, and below it its real part, the unstable ranges shaded. \
 --reference FILE.csv adds the columns of a CSV (its first column the param) as lines on the \
-real parts.
+real parts. While the grid runs, the CSV is rewritten about every second with the points \
+finished from the grid's start, so a long sweep can be read as it goes.
 
 Examples:
   mbd stability models/windmill.mbd --sweep Omega_bar=0.8:2.6:0.05 -o stab.csv --chart stab.svg
@@ -182,9 +186,26 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         sets: &a.set,
     };
     let progress = Evaluations::new("evaluations");
-    let result = sweep::sweep(&spec, &|extra| jobs.with_sets(extra), &|t| progress.tick(t));
+    // The CSV rewritten as the grid's points finish (at most every STREAM_EVERY), then whole.
+    let stream = Mutex::new((&mut csv_file, None::<Instant>));
+    let rows = |partial: &sweep::Sweep| {
+        if let Ok(mut g) = stream.lock() {
+            let (file, last) = &mut *g;
+            if last.is_none_or(|t| t.elapsed() >= STREAM_EVERY) {
+                *last = Some(Instant::now());
+                // A failure here is reported by the final write.
+                let _ = rewrite(file, partial);
+            }
+        }
+    };
+    let result = sweep::sweep_streaming(
+        &spec,
+        &|extra| jobs.with_sets(extra),
+        &|t| progress.tick(t),
+        &rows,
+    );
     progress.finish();
-    if let Err(e) = result.write_csv(&mut csv_file) {
+    if let Err(e) = rewrite(&mut csv_file, &result) {
         return usage(&format!("cannot write `{}`: {e}", a.output));
     }
     if let Some((p, f)) = chart_file.as_mut() {
@@ -206,6 +227,18 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
     }
     print_report(&result);
     exit_unless_failed(result.points.iter().any(|p| p.failure.is_some()))
+}
+
+/// How often the CSV is rewritten while the grid runs.
+const STREAM_EVERY: Duration = Duration::from_secs(1);
+
+/// The file emptied, then the sweep's CSV written into it.
+fn rewrite(file: &mut std::fs::File, s: &sweep::Sweep) -> std::io::Result<()> {
+    file.set_len(0)?;
+    file.seek(SeekFrom::Start(0))?;
+    let mut out = std::io::BufWriter::new(file);
+    s.write_csv(&mut out)?;
+    out.flush()
 }
 
 /// The methods (the primary first) and Prony's window, with the flags that belong to them

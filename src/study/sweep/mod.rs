@@ -25,6 +25,7 @@ use crate::Compiled;
 use point::evaluate;
 use std::fmt::Display;
 use std::io::{self, Write};
+use std::sync::Mutex;
 
 /// Compiles the model with these extra `NAME=VALUE` params; the error (by default a
 /// [`super::CompileError`]) is shown as the point's failure.
@@ -159,7 +160,19 @@ pub fn sweep<E: Display>(
     compile: &CompileWith<E>,
     tick: &(dyn Fn(Tick) + Sync),
 ) -> Sweep {
-    let mut points = grid_points(spec, compile, tick);
+    sweep_streaming(spec, compile, tick, &|_| {})
+}
+
+/// [`sweep`], with `rows` called as the grid's points finish: each time the run of finished
+/// points from the grid's start grows, with the sweep of that run (its modes followed, no
+/// edges yet), whose CSV is the final one's first rows.
+pub fn sweep_streaming<E: Display>(
+    spec: &SweepSpec,
+    compile: &CompileWith<E>,
+    tick: &(dyn Fn(Tick) + Sync),
+    rows: &(dyn Fn(&Sweep) + Sync),
+) -> Sweep {
+    let mut points = grid_points(spec, compile, tick, rows);
     tracks::follow(&mut points);
     let Some(&primary) = spec.methods.first() else {
         return Sweep {
@@ -196,11 +209,12 @@ pub fn sweep<E: Display>(
     }
 }
 
-/// Every value with every method, in parallel.
+/// Every value with every method, in parallel; `rows` gets the finished run from the start.
 fn grid_points<E: Display>(
     spec: &SweepSpec,
     compile: &CompileWith<E>,
     tick: &(dyn Fn(Tick) + Sync),
+    rows: &(dyn Fn(&Sweep) + Sync),
 ) -> Vec<Point> {
     let jobs: Vec<(f64, Method)> = spec
         .values
@@ -208,8 +222,36 @@ fn grid_points<E: Display>(
         .flat_map(|&v| spec.methods.iter().map(move |&m| (v, m)))
         .collect();
     tick(Tick::Planned(jobs.len()));
+    // The points finished beyond the run from the start, and that run as a sweep (its
+    // modes followed, their shapes dropped once followed).
+    let state = Mutex::new((
+        vec![None; jobs.len()],
+        tracks::Follower::default(),
+        Sweep {
+            param: spec.param.clone(),
+            points: Vec::new(),
+            refinements: Vec::new(),
+            edges: Vec::new(),
+            threshold: spec.threshold,
+            notes: Vec::new(),
+        },
+    ));
     parallel(jobs.len(), |k| {
-        evaluate(spec, jobs[k].0, jobs[k].1, compile, tick)
+        let p = evaluate(spec, jobs[k].0, jobs[k].1, compile, tick);
+        if let Ok(mut guard) = state.lock() {
+            let (pending, follower, run) = &mut *guard;
+            pending[k] = Some(p.clone());
+            let from = run.points.len();
+            while let Some(mut q) = pending.get_mut(run.points.len()).and_then(Option::take) {
+                follower.next(&mut q);
+                q.shapes = Vec::new();
+                run.points.push(q);
+            }
+            if run.points.len() > from {
+                rows(run);
+            }
+        }
+        p
     })
     .into_iter()
     .enumerate()

@@ -9,19 +9,35 @@ use std::io::{self, Write};
 
 /// Gives every mode of the grid's points its track: per method, along the grid's order.
 pub(super) fn follow(points: &mut [Point]) {
-    let mut trackers: Vec<(Method, Tracker)> = Vec::new();
-    for p in points.iter_mut().filter(|p| p.failure.is_none()) {
-        let k = match trackers.iter().position(|(m, _)| *m == p.method) {
+    let mut follower = Follower::default();
+    for p in points.iter_mut() {
+        follower.next(p);
+    }
+}
+
+/// The tracks of each method so far, point by point along the grid.
+#[derive(Default)]
+pub(super) struct Follower {
+    trackers: Vec<(Method, Tracker)>,
+}
+
+impl Follower {
+    /// The tracks of the next point's modes (none for a failed point).
+    pub(super) fn next(&mut self, p: &mut Point) {
+        if p.failure.is_some() {
+            return;
+        }
+        let k = match self.trackers.iter().position(|(m, _)| *m == p.method) {
             Some(k) => k,
             None => {
-                trackers.push((p.method, Tracker::new()));
-                trackers.len() - 1
+                self.trackers.push((p.method, Tracker::new()));
+                self.trackers.len() - 1
             }
         };
         let keys: Vec<(c64, &[c64])> = (p.modes.iter().enumerate())
             .map(|(i, s)| (*s, p.shapes.get(i).map_or(&[][..], |v| &v[..])))
             .collect();
-        p.tracks = trackers[k].1.follow(&keys);
+        p.tracks = self.trackers[k].1.follow(&keys);
     }
 }
 
