@@ -75,6 +75,8 @@ pub struct Assembler {
     /// Per element of `reading.0`, its local `M` then `C` (row-major, `nl x nl` each) at the
     /// state of the last [`Assembler::rate_jacobians`]; sized on its first call.
     rate_local: Vec<f64>,
+    /// [`Assembler::rate_products`]' workspace: an element's rates, all directions.
+    rate_work: Vec<f64>,
     pub residual: Residual,
     /// Generalized momenta `P = M(q) V` and transport terms `G` (`dP/dt + G = F^I`).
     pub momentum: Vec<f64>,
@@ -115,6 +117,7 @@ impl Assembler {
                 .filter(|&e| sys.elements[e].reads_rates())
                 .partition(|&e| sys.elements[e].has_rates()),
             rate_local: Vec::new(),
+            rate_work: Vec::new(),
             residual: Residual::new(n),
             momentum: vec![0.0; n],
             transport: vec![0.0; n],
@@ -273,6 +276,58 @@ impl Assembler {
                     }
                 }
                 out[gi] += sum;
+            }
+        }
+    }
+
+    /// [`Assembler::rate_product`] for `count` directions at once (`dv`, `da`, `out`
+    /// column-major `n x count`): each element's derivatives read once for all of them.
+    pub fn rate_products(&mut self, dv: &[f64], da: &[f64], count: usize, out: &mut [f64]) {
+        let n = out.len() / count.max(1);
+        let widest = (self.reading.0.iter())
+            .map(|&e| self.indices[e].len())
+            .max()
+            .unwrap_or(0);
+        if self.rate_work.len() < (2 * widest + 1) * count {
+            self.rate_work.resize((2 * widest + 1) * count, 0.0);
+        }
+        let mut at = 0;
+        for &e in &self.reading.0 {
+            let idx = &self.indices[e];
+            let nl = idx.len();
+            let (m, c) = self.rate_local[at..at + 2 * nl * nl].split_at(nl * nl);
+            at += 2 * nl * nl;
+            // The element's rates, row j holding every direction's.
+            let (la, rest) = self.rate_work.split_at_mut(nl * count);
+            let (lv, rest) = rest.split_at_mut(nl * count);
+            let sum = &mut rest[..count];
+            for (j, &gj) in idx.iter().enumerate() {
+                for k in 0..count {
+                    (la[j * count + k], lv[j * count + k]) = if gj < n {
+                        (da[k * n + gj], dv[k * n + gj])
+                    } else {
+                        (0.0, 0.0)
+                    };
+                }
+            }
+            for (i, &gi) in idx.iter().enumerate().filter(|&(_, &gi)| gi < n) {
+                sum.fill(0.0);
+                for j in 0..nl {
+                    let (a, b) = (m[i * nl + j], c[i * nl + j]);
+                    if a == 0.0 && b == 0.0 {
+                        continue;
+                    }
+                    let (xa, xv) = (
+                        &la[j * count..(j + 1) * count],
+                        &lv[j * count..(j + 1) * count],
+                    );
+                    for ((s, x), y) in sum.iter_mut().zip(xa).zip(xv) {
+                        *s += a * x + b * y;
+                    }
+                }
+                for (k, s) in sum.iter().enumerate() {
+                    out[k * n + gi] += s;
+                }
             }
         }
     }

@@ -51,7 +51,8 @@ pub(super) struct Tracked {
     nodes: Vec<NodeMap>,
     dir: Vec<f64>,
     part: Vec<f64>,
-    /// A direction's velocities and accelerations as the state holds them.
+    /// Each direction's velocities and accelerations as the state holds them (column-major
+    /// `n x columns`).
     physical: (Vec<f64>, Vec<f64>),
     /// Column-major `n x columns`: each direction's correction of the increment.
     gradients: Vec<f64>,
@@ -283,7 +284,7 @@ impl Integrator<'_> {
             nodes: vec![NodeMap::default(); nodes],
             dir: vec![0.0; 4 * n],
             part: vec![0.0; n],
-            physical: (vec![0.0; n], vec![0.0; n]),
+            physical: (vec![0.0; n * count], vec![0.0; n * count]),
             gradients: vec![0.0; n * count],
         }));
     }
@@ -459,19 +460,26 @@ impl Integrator<'_> {
             tk.part.copy_from_slice(&moved[..n]);
             tk.part.iter_mut().for_each(|x| *x = -*x);
             self.correct(&coef, &tk.nodes, &tk.part, moved);
+            if analytic {
+                let (dv, da) = (&mut tk.physical.0, &mut tk.physical.1);
+                let (dv, da) = (&mut dv[c * n..(c + 1) * n], &mut da[c * n..(c + 1) * n]);
+                physical_rates(self.sys, &self.in_frame, &self.cur, moved, (dv, da));
+            }
+        }
+        // The elements with inertia or damping through their derivatives, `-(M da + C dv)`.
+        if analytic {
+            let (dv, da) = (&tk.physical.0, &tk.physical.1);
+            self.asm.rate_products(dv, da, tk.count, &mut tk.gradients);
+            tk.gradients.iter_mut().for_each(|g| *g = -*g);
+        }
+        for c in 0..tk.count {
+            let moved = &tk.columns[c * dim..(c + 1) * dim];
             let size = rate_size(&tk.scale, tk.tau, moved);
             if size == 0.0 {
                 continue;
             }
             let eps = EPSILON / size;
             let gradient = &mut tk.gradients[c * n..(c + 1) * n];
-            // The elements with inertia or damping through their derivatives, `-(M da + C dv)`.
-            if analytic {
-                let (dv, da) = (&mut tk.physical.0, &mut tk.physical.1);
-                physical_rates(self.sys, &self.in_frame, &self.cur, moved, (dv, da));
-                self.asm.rate_product(dv, da, gradient);
-                gradient.iter_mut().for_each(|g| *g = -*g);
-            }
             // The rest (joints with rate rows, or all) by central differences along the rates.
             for sign in [1.0, -1.0].into_iter().filter(|_| differenced) {
                 perturb_rates(

@@ -325,6 +325,18 @@ fn the_rate_derivatives_are_the_residuals_along_the_rates() {
         it.asm.rate_jacobians(sys, &cur, aug);
         let mut analytic = vec![0.0; n];
         it.asm.rate_product(&dv, &da, &mut analytic);
+        // All directions at once: the same products, column by column.
+        let twice = |x: &[f64]| -> Vec<f64> { x.iter().chain(x).map(|v| v * 1.5).collect() };
+        let mut batched = vec![0.0; 2 * n];
+        it.asm
+            .rate_products(&twice(&dv), &twice(&da), 2, &mut batched);
+        for (k, b) in batched.iter().enumerate() {
+            let a = 1.5 * analytic[k % n];
+            assert!(
+                (a - b).abs() <= 1e-14 * a.abs().max(1.0),
+                "{model}: {k}: {a} vs {b}"
+            );
+        }
         let row = |r: &crate::runtime::Residual, i: usize| {
             if sys.unknowns[i].is_multiplier() {
                 aug.s * r.constraint[i]
