@@ -169,12 +169,12 @@ pub fn floquet_by(
     let how = if it.can_track() { how } else { Monodromy::Runs };
     if how == Monodromy::Runs && space.massless() > 0 {
         return Err(reference_failure(RuntimeFailure {
-            kind: super::FailureKind::Unsupported,
+            kind: super::FailureKind::RunsUnavailable,
             t: 0.0,
             step: 0,
             entity: None,
             detail: format!(
-                "{} of the model's {} free directions carry no inertia (beam nodes without rotary inertia), and the monodromy from perturbed runs is not reliable for them: a perturbation of one is not a state of the motion, and the first step's response to it is far from linear; use the step's tangent (--monodromy tangent, with HHT or generalized-alpha and incremental rotations) or give the sections rotary inertia",
+                "{} of the model's {} free directions carry no inertia (beam nodes without rotary inertia), and a perturbation of one is not a state of the motion; use the step's tangent (--monodromy tangent, with HHT or generalized-alpha and incremental rotations) or give the sections rotary inertia",
                 space.massless(),
                 space.r
             ),
