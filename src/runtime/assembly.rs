@@ -223,6 +223,17 @@ impl Assembler {
         }
     }
 
+    /// Whether some element that reads the rates holds elastic forces far above its inertial
+    /// ones (a beam): differences of its residual along the rates cancel those forces only to
+    /// their round-off (a rotating beam's carried direction: 8e-7 from differences, 2e-11
+    /// from [`Assembler::rate_jacobians`]).
+    pub fn rates_need_derivatives(&self, sys: &System) -> bool {
+        self.reading
+            .0
+            .iter()
+            .any(|&e| matches!(sys.elements[e], Element::Beam(_)))
+    }
+
     /// Whether [`Assembler::rate_residual`] evaluates some element.
     pub fn has_rate_residual(&self, all: bool) -> bool {
         !self.reading.1.is_empty() || (all && !self.reading.0.is_empty())
@@ -230,7 +241,7 @@ impl Assembler {
 
     /// The residual's derivatives with respect to the accelerations (`M`) and the velocities
     /// (`C`) at a state, kept per element with inertia or damping for
-    /// [`Assembler::rate_product`] (their tangents' `mass` and `velocity` parts, as
+    /// [`Assembler::rate_products`] (their tangents' `mass` and `velocity` parts, as
     /// [`Assembler::add_rate_columns`] takes them).
     pub fn rate_jacobians(&mut self, sys: &System, st: &State, aug: Augment) {
         let size: usize = (self.reading.0.iter())
@@ -255,33 +266,11 @@ impl Assembler {
         }
     }
 
-    /// `out += M da + C dv` with the derivatives of the last [`Assembler::rate_jacobians`]:
-    /// the residual's change along a change of the rates alone (velocities `dv` and
-    /// accelerations `da` as the state holds them: rotations' entries are angular velocities
-    /// and accelerations).
-    pub fn rate_product(&self, dv: &[f64], da: &[f64], out: &mut [f64]) {
-        let n = out.len();
-        let mut at = 0;
-        for &e in &self.reading.0 {
-            let idx = &self.indices[e];
-            let nl = idx.len();
-            let (m, c) = self.rate_local[at..at + 2 * nl * nl].split_at(nl * nl);
-            at += 2 * nl * nl;
-            for (i, &gi) in idx.iter().enumerate().filter(|&(_, &gi)| gi < n) {
-                let (mi, ci) = (&m[i * nl..(i + 1) * nl], &c[i * nl..(i + 1) * nl]);
-                let mut sum = 0.0;
-                for ((&gj, a), b) in idx.iter().zip(mi).zip(ci) {
-                    if gj < n {
-                        sum += a * da[gj] + b * dv[gj];
-                    }
-                }
-                out[gi] += sum;
-            }
-        }
-    }
-
-    /// [`Assembler::rate_product`] for `count` directions at once (`dv`, `da`, `out`
-    /// column-major `n x count`): each element's derivatives read once for all of them.
+    /// `out += M da + C dv` with the derivatives of the last [`Assembler::rate_jacobians`],
+    /// for `count` directions at once (`dv`, `da`, `out` column-major `n x count`): the
+    /// residual's change along a change of the rates alone (velocities and accelerations as
+    /// the state holds them: rotations' entries are angular velocities and accelerations),
+    /// each element's derivatives read once for all the directions.
     pub fn rate_products(&mut self, dv: &[f64], da: &[f64], count: usize, out: &mut [f64]) {
         let n = out.len() / count.max(1);
         let widest = (self.reading.0.iter())

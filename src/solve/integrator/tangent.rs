@@ -37,7 +37,7 @@ const EPSILON: f64 = 1e-3;
 /// below, from central differences of the elements' residuals (two per element and
 /// direction), cheaper for the rigid windmill's 10 (measured: 10 % less per point) and far
 /// dearer for an elastic rotor's hundreds.
-const ANALYTIC_ABOVE: usize = 16;
+pub(super) const ANALYTIC_ABOVE: usize = 16;
 
 /// The directions carried along a run, and the step's workspace (made once).
 pub(super) struct Tracked {
@@ -439,9 +439,10 @@ impl Integrator<'_> {
         tk.gradients.iter_mut().for_each(|x| *x = 0.0);
         // The perturbed states below differ from the end's in their rates alone.
         self.trial.assign(&self.cur);
-        // Many directions: the elements with inertia through their derivatives, assembled
-        // once; few: every element that reads the rates by differences.
-        let analytic = tk.count > ANALYTIC_ABOVE;
+        // Many directions, or beams: the elements with inertia through their derivatives,
+        // assembled once; few on rigid bodies: every element that reads the rates by
+        // differences.
+        let analytic = tk.count > ANALYTIC_ABOVE || self.asm.rates_need_derivatives(self.sys);
         if analytic {
             self.asm.rate_jacobians(self.sys, &self.cur, aug);
         }
