@@ -195,7 +195,6 @@ impl Compiled {
             FailureKind::NonFinite => (Code::E0603, "non-finite values", "try a smaller time step (--dt); check params for extreme values"),
             FailureKind::Interrupted => (Code::E0607, "run interrupted", "the run was stopped (Ctrl-C); the output keeps every row computed before it"),
             FailureKind::Unsupported => (Code::E0604, "integrator not available", "time finite elements integrate rotations incrementally: drop `--rotations conformal`, or use `--integrator hht` for the conformal treatment"),
-            FailureKind::RunsUnavailable => (Code::E0608, "monodromy by perturbed runs not available", "use the step's tangent (`--monodromy tangent`, with `hht` or `generalized_alpha` and incremental rotations), or give the beam sections rotary inertia"),
         };
         let Ok(l) = &self.lowered else {
             return Diagnostic::error(code, what.to_string()).hint(hint);
@@ -209,10 +208,7 @@ impl Compiled {
         };
         let mut d = Diagnostic::error(
             code,
-            if matches!(
-                f.kind,
-                FailureKind::Unsupported | FailureKind::RunsUnavailable
-            ) {
+            if matches!(f.kind, FailureKind::Unsupported) {
                 format!("{what}: {}", f.detail)
             } else {
                 format!(

@@ -82,7 +82,6 @@ const ELSEWHERE: &[Code] = &[
     Code::E0603,
     Code::E0604,
     Code::E0605,
-    Code::E0608,
     Code::W0601,
     Code::W0602,
 ];
@@ -490,30 +489,4 @@ fn modes_refuses_a_rotor_on_a_still_mast_and_names_both() {
     // The still mast and the turning hub, each at its declaration.
     assert_eq!(d.labels.len(), 2, "{:?}", d.labels);
     insta::assert_snapshot!("modes_not_steady", render_all(&[d], &c.sources));
-}
-
-/// Floquet's perturbed runs refuse a model with directions without inertia (the elastic
-/// windmill's beam nodes have no rotary inertia): E0608, with the count and what to use.
-#[test]
-fn perturbed_runs_refuse_a_model_with_directions_without_inertia() {
-    let path = "models/windmill_elastic.mbd";
-    let text = crate::common::read(path);
-    let c = match mbd::compile(path, &text, &[], Request::default()) {
-        Ok(c) => c,
-        Err(f) => panic!("the elastic windmill does not compile: {:?}", f.diagnostics),
-    };
-    let sys = match &c.lowered {
-        Ok(l) => &l.system,
-        Err(d) => panic!("not runnable: {}", d.message),
-    };
-    let period = mbd::study::sweep::rotor_period(&c).expect("a driven rotor");
-    let how = mbd::solve::floquet::Monodromy::Runs;
-    let f = match mbd::solve::floquet::floquet_by(sys, &c.settings, period, how, &|| {}) {
-        Err(f) => f,
-        Ok(_) => panic!("perturbed runs must refuse directions without inertia"),
-    };
-    let d = c.failure_diagnostic(&f.failure);
-    assert_eq!(d.code, Code::E0608);
-    assert!(d.message.contains("carry no inertia"), "{}", d.message);
-    insta::assert_snapshot!("floquet_runs_without_inertia", render_all(&[d], &c.sources));
 }

@@ -24,12 +24,12 @@ motion, and the edges of the unstable ranges.
 Floquet (--method floquet, the default): the monodromy matrix of the discrete motion over one \
 period T (2 pi / Omega of the joint driven at a constant speed, or --period) with the model's \
 integrator and step, in the constraint-free subspace (THEORY §9.2): by default from the step's \
-own tangent, the state's directions (n_f positions, and velocities along the n_m directions \
-with inertia) carried through one run of the period by the converged steps' iteration \
-matrices (the HHT and generalized-alpha integrators with incremental rotations; \
+own tangent, the state's directions (positions and velocities along the n_m directions with \
+inertia; positions without inertia, such as the rotations of beam nodes without rotary inertia, \
+follow the others in equilibrium) carried through one run of the period by the converged steps' \
+iteration matrices (the HHT and generalized-alpha integrators with incremental rotations; \
 --monodromy runs, time finite elements and conformal rotations build it from two perturbed \
-runs of one period per direction, and refuse a model with directions without inertia, such \
-as beam nodes without rotary inertia). Exponents s = (ln|Lambda| + \
+runs of one period per direction). Exponents s = (ln|Lambda| + \
 i arg Lambda) / T. A multiplier gives the frequency only modulo 2 pi / T: with the tangent, \
 the frequency is the principal branch's plus the dominant harmonic of the mode's time history \
 over the period (the blades' frequency for a mode of a rotor's lag angles); --monodromy runs \

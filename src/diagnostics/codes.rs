@@ -269,16 +269,6 @@ their stability is Floquet analysis over one period, `mbd stability`. A state th
 (a pendulum released from the side, a structure not yet deflected under its load) is not an \
 equilibrium. `mbd modes --frozen` gives the eigenvalues of the equations frozen at t = 0 anyway, \
 marked `frozen` on every output: they are not the system's modes.";
-    E0608 = "E0608", "monodromy by perturbed runs not available",
-        "`mbd stability --monodromy runs` (and Floquet analysis with time finite elements or \
-conformal rotations, which build the monodromy that way) perturbs every free direction of the \
-model and integrates each perturbed start over a period. A direction without inertia (a beam \
-node without rotary inertia) has no velocity state and its position follows the others': a \
-perturbation of it is not a state of the motion, the first step answers it tens of thousands \
-of times its size, and the differences are far from linear (the elastic windmill gave a growth \
-rate of 8.36 1/s for 1.257). Use the step's own tangent (`--monodromy tangent`, the default, \
-with `hht` or `generalized_alpha` and incremental rotations), which is linear and exact for \
-such models, or give the beam sections rotary inertia.";
     W0201 = "W0201", "unused param",
         "A param is declared but nothing uses it, not even an output. Remove it, or use it.";
     W0202 = "W0202", "unused declaration",

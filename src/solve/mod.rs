@@ -27,8 +27,6 @@ pub enum FailureKind {
     Singular,
     NonFinite,
     Unsupported,
-    /// Floquet's perturbed runs refused: the model has directions without inertia.
-    RunsUnavailable,
     /// Stopped by [`interrupt`] (Ctrl-C) between steps.
     Interrupted,
 }

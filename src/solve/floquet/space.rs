@@ -1,14 +1,15 @@
-//! The perturbation space of a Floquet analysis (THEORY §9.2 step 2): positions along the
-//! null space `N0` of the weighted constraint gradient, velocities along its directions that
-//! carry inertia; the measure `z` of a state and the perturbed starts.
+//! The perturbation space of a Floquet analysis (THEORY §9.2 step 2): positions and
+//! velocities along the directions of the null space `N0` of the weighted constraint gradient
+//! that carry inertia; the measure `z` of a state and the perturbed starts.
 //!
 //! A direction of `N0` without inertia (`N0^T W M W N0 u = 0`: the rotations of beam nodes
-//! without rotary inertia) has no velocity state: its motion follows the others' (its
-//! acceleration is not an unknown of the equations of motion), and the rate an integrator
-//! carries for it is a by-product of its Newmark relations, which no residual reads. Such
-//! velocities are neither perturbed nor measured, so the state has `n_f + n_m` entries (`n_m`
-//! the directions with inertia) and its multipliers are the motion's. Its positions stay: a
-//! perturbation of one relaxes within a step (a multiplier of about zero).
+//! without rotary inertia) is no state: the balance holds along it at every step, so its
+//! position follows the others' (and the rate an integrator carries for it is a by-product of
+//! its Newmark relations, which no residual reads). Each perturbed start displaces such
+//! directions into the equilibrium of the balance linearized at the start (stiffness, and the
+//! damping of a velocity perturbation), so it is a state of the motion, and the measure reads
+//! only the directions with inertia: `z` has `2 n_m` entries and its multipliers are the
+//! motion's.
 
 use crate::runtime::rotation::{exp, log, V3};
 use crate::runtime::{State, System, UnknownKind};
@@ -27,12 +28,16 @@ const MASSLESS: f64 = 1e-10;
 pub(super) struct Space {
     pub(super) free: Vec<usize>,
     pub(super) weights: Vec<f64>,
-    /// `N0`, column-major `nfree x r`.
-    pub(super) basis: Vec<f64>,
+    /// The dimension of `N0`.
     pub(super) r: usize,
-    /// The directions of `N0` with inertia, column-major `nfree x rv` (orthonormal).
+    /// The directions of `N0` with inertia, column-major `nfree x rv` (orthonormal): the
+    /// state's positions and velocities both.
     velocities: Vec<f64>,
     rv: usize,
+    /// Column-major `nfree x 2 rv`: the displacement along the directions without inertia
+    /// that keeps them in equilibrium when the position (column `c`) or the velocity
+    /// (column `rv + c`) of direction `c` moves by one.
+    slaved: Vec<f64>,
     pub(super) omega: f64,
     pub(super) start: State,
 }
@@ -100,26 +105,27 @@ impl Space {
         for &c in &kept {
             velocities.extend((&n0 * eig.eigenvectors.column(c)).iter());
         }
+        let massless: Vec<usize> = (0..r).filter(|c| !kept.contains(c)).collect();
+        let pick =
+            |cols: &[usize]| DMatrix::from_fn(r, cols.len(), |i, j| eig.eigenvectors[(i, cols[j])]);
+        let (uv, uk) = (pick(&kept), pick(&massless));
+        let slaved = slaved(lin, &nw, &n0, (&uv, &uk), omega);
         Ok(Space {
             free: lin.unknowns.clone(),
             weights,
-            basis,
             r,
             velocities,
             rv: kept.len(),
+            slaved,
             omega,
             start,
         })
     }
 
-    /// The directions of `N0` without inertia.
-    pub(super) fn massless(&self) -> usize {
-        self.r - self.rv
-    }
-
-    /// The state's dimension: `n_f` positions, `n_m` velocities.
+    /// The state's dimension: positions and velocities along the `n_m` directions with
+    /// inertia.
     pub(super) fn dim(&self) -> usize {
-        self.r + self.rv
+        2 * self.rv
     }
 
     /// The weighted displacements and rates (over `Omega`) of the free unknowns of `st` from
@@ -145,14 +151,14 @@ impl Space {
     }
 
     /// `z` from displacements and rates (columns of `dq`, `dv`, `nfree` rows each):
-    /// `(N0^T dq, V^T dv)`.
+    /// `(V^T dq, V^T dv)` (the directions without inertia follow the others).
     pub(super) fn project(&self, dq: &DMatrix<f64>, dv: &DMatrix<f64>) -> DMatrix<f64> {
         let nfree = self.free.len();
-        let n0 = DMatrix::from_column_slice(nfree, self.r, &self.basis);
         let v = DMatrix::from_column_slice(nfree, self.rv, &self.velocities);
         let mut z = DMatrix::<f64>::zeros(self.dim(), dq.ncols());
-        z.rows_mut(0, self.r).copy_from(&(n0.transpose() * dq));
-        z.rows_mut(self.r, self.rv).copy_from(&(v.transpose() * dv));
+        z.rows_mut(0, self.rv).copy_from(&(v.transpose() * dq));
+        z.rows_mut(self.rv, self.rv)
+            .copy_from(&(v.transpose() * dv));
         z
     }
 
@@ -169,33 +175,40 @@ impl Space {
     pub(super) fn shape(&self, v: &[(f64, f64)]) -> Vec<c64> {
         let nfree = self.free.len();
         let mut out = vec![c64::new(0.0, 0.0); 2 * nfree];
-        let halves = [(&self.basis, 0, 0), (&self.velocities, nfree, self.r)];
-        for (cols, half, at) in halves {
-            for (c, col) in cols.chunks(nfree).enumerate() {
-                let x = v[at + c];
-                for (o, b) in out[half..half + nfree].iter_mut().zip(col) {
-                    o.re += b * x.0;
-                    o.im += b * x.1;
-                }
+        let mut add = |half: usize, col: &[f64], x: (f64, f64)| {
+            for (o, b) in out[half..half + nfree].iter_mut().zip(col) {
+                o.re += b * x.0;
+                o.im += b * x.1;
             }
+        };
+        for c in 0..self.rv {
+            let (col, (p, u)) = (
+                &self.velocities[c * nfree..][..nfree],
+                (v[c], v[self.rv + c]),
+            );
+            add(0, col, p);
+            add(0, &self.slaved[c * nfree..][..nfree], p);
+            add(0, &self.slaved[(self.rv + c) * nfree..][..nfree], u);
+            add(nfree, col, u);
         }
         out
     }
 
-    /// The model's initial state perturbed by `eps` along state direction `dir` (positions
-    /// along `N0` for `dir < r`, velocities along the directions with inertia otherwise).
+    /// The model's initial state perturbed by `eps` along state direction `dir` (the
+    /// position of direction `dir < rv`, else the velocity of `dir - rv`), the directions
+    /// without inertia displaced to stay in equilibrium.
     pub(super) fn perturbed(&self, sys: &System, dir: usize, eps: f64) -> State {
         let nfree = self.free.len();
-        let (col, velocity) = if dir < self.r {
-            (&self.basis[dir * nfree..(dir + 1) * nfree], false)
-        } else {
-            let c = dir - self.r;
-            (&self.velocities[c * nfree..(c + 1) * nfree], true)
-        };
+        let (c, velocity) = (dir % self.rv, dir >= self.rv);
+        let col = &self.velocities[c * nfree..(c + 1) * nfree];
+        let follow = &self.slaved[dir * nfree..(dir + 1) * nfree];
         let mut st = sys.initial.clone();
         let mut turns = vec![V3::zeros(); sys.rotations.len()];
-        for (j, &i) in self.free.iter().enumerate() {
-            let d = eps * self.weights[j] * col[j];
+        let moves = col.iter().map(|&x| (x, velocity)).enumerate();
+        let follows = follow.iter().map(|&x| (x, false)).enumerate();
+        for (j, (x, velocity)) in moves.chain(follows) {
+            let i = self.free[j];
+            let d = eps * self.weights[j] * x;
             match (sys.unknowns[i], velocity) {
                 (UnknownKind::Rotation { node, axis }, false) => turns[node][axis] += d,
                 (UnknownKind::Rotation { node, axis }, true) => {
@@ -213,4 +226,37 @@ impl Space {
         }
         st
     }
+}
+
+/// The displacements along the directions without inertia (`uk`, in `N0`'s coordinates) that
+/// keep them in equilibrium when a direction with inertia (`uv`) moves: the linearized balance
+/// along them, `Uk^T (K dq + G dv) = 0` (stiffness and damping over `N0`, weighted by `nw`),
+/// solved for their part of `dq`; column-major `nfree x 2 rv` in weighted coordinates, the
+/// positions' columns then the velocities' (a velocity of one is `omega` in rate).
+fn slaved(
+    lin: &Linearization,
+    nw: &DMatrix<f64>,
+    n0: &DMatrix<f64>,
+    (uv, uk): (&DMatrix<f64>, &DMatrix<f64>),
+    omega: f64,
+) -> Vec<f64> {
+    let (nfree, rv) = (n0.nrows(), uv.ncols());
+    if uk.ncols() == 0 {
+        return vec![0.0; nfree * 2 * rv];
+    }
+    let over = |flat: &[f64]| nw.transpose() * DMatrix::from_row_slice(nfree, nfree, flat) * nw;
+    let (kr, gr) = (over(&lin.k), over(&lin.g));
+    let kkk = uk.transpose() * &kr * uk;
+    // Directions with neither inertia nor stiffness (none in a well-posed model) stay put.
+    let top = kkk.amax();
+    let inverse = kkk
+        .pseudo_inverse(1e-12 * top.max(f64::MIN_POSITIVE))
+        .unwrap_or_else(|_| DMatrix::zeros(uk.ncols(), uk.ncols()));
+    let mut rhs = DMatrix::<f64>::zeros(uk.ncols(), 2 * rv);
+    rhs.columns_mut(0, rv)
+        .copy_from(&(uk.transpose() * &kr * uv));
+    rhs.columns_mut(rv, rv)
+        .copy_from(&(uk.transpose() * &gr * uv * omega));
+    let follow = n0 * uk * (inverse * rhs) * -1.0;
+    follow.as_slice().to_vec()
 }
