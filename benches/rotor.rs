@@ -2,7 +2,9 @@
 //! HHT -0.1), and one point of a stability sweep by each method at Omega_bar = 1.5 (Floquet:
 //! the step's tangent carried through one run of the period, the 10 perturbed starts made
 //! consistent; Prony: the 3 s run and the matrix-pencil fit). The
-//! 3 s run is also timed with the matrix kept (`newton = auto`). A 50-point sweep costs about
+//! 3 s run is also timed with the matrix kept (`newton = auto`), and the Floquet point of the
+//! elastic windmill (4 elements per blade: 194 directions, deflated to 90 as the integrator
+//! damps the stiff modes). A 50-point sweep costs about
 //! 50 Floquet points over the cores; its wall time is measured by `mbd stability` itself (see
 //! the closing note of issue 7).
 
@@ -49,6 +51,20 @@ fn runs(c: &mut Criterion) {
         c.bench_function(&format!("windmill: one {} point", method.name()), |b| {
             b.iter(|| sweep::sweep(&spec, &compile, &|_| {}).points[0].max_real())
         });
+        if method == Method::Floquet {
+            // The elastic windmill, 4 elements per blade (issue 22's target).
+            let elastic = common::model_text("windmill_elastic.mbd");
+            let compile = |extra: &[String]| {
+                let mut sets = vec!["elements=4".to_string()];
+                sets.extend_from_slice(extra);
+                mbd::compile("windmill_elastic.mbd", &elastic, &sets, Request::default())
+                    .map_err(|f| format!("{:?}", f.diagnostics))
+            };
+            let name = "windmill_elastic, 4 elements per blade: one floquet point";
+            c.bench_function(name, |b| {
+                b.iter(|| sweep::sweep(&spec, &compile, &|_| {}).points[0].max_real())
+            });
+        }
     }
 }
 

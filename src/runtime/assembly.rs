@@ -72,6 +72,9 @@ pub struct Assembler {
     /// inertia or damping, whose tangents split into `M` and `C` ([`Element::has_rates`]),
     /// and the rest (joints with rate rows).
     reading: (Vec<usize>, Vec<usize>),
+    /// The unknowns of the elements that [`Assembler::rate_residual`] evaluates: of
+    /// `reading.1` alone, and of both (sorted).
+    rate_support: (Vec<usize>, Vec<usize>),
     /// Per element of `reading.0`, its local `M` then `C` (row-major, `nl x nl` each) at the
     /// state of the last [`Assembler::rate_jacobians`]; sized on its first call.
     rate_local: Vec<f64>,
@@ -105,6 +108,19 @@ impl Assembler {
         }
         let values = vec![0.0; pattern.nnz()];
         let rated = Self::rated(sys, &indices);
+        let reading: (Vec<usize>, Vec<usize>) = (0..sys.elements.len())
+            .filter(|&e| sys.elements[e].reads_rates())
+            .partition(|&e| sys.elements[e].has_rates());
+        let support = |elements: &[&[usize]]| {
+            let mut all: Vec<usize> = elements
+                .iter()
+                .flat_map(|set| set.iter().flat_map(|&e| indices[e].iter().copied()))
+                .collect();
+            all.sort_unstable();
+            all.dedup();
+            all
+        };
+        let rate_support = (support(&[&reading.1]), support(&[&reading.0, &reading.1]));
         Assembler {
             pattern,
             values,
@@ -113,9 +129,8 @@ impl Assembler {
             local: vec![0.0; largest * largest],
             local2: vec![0.0; largest * largest],
             rated,
-            reading: (0..sys.elements.len())
-                .filter(|&e| sys.elements[e].reads_rates())
-                .partition(|&e| sys.elements[e].has_rates()),
+            reading,
+            rate_support,
             rate_local: Vec::new(),
             rate_work: Vec::new(),
             residual: Residual::new(n),
@@ -214,9 +229,18 @@ impl Assembler {
     /// The residual parts of the elements that read the rates (`all`), or of those whose
     /// derivatives are not in [`Assembler::rate_jacobians`] (joints with rate rows): its
     /// difference between two states of the same positions is the whole residual's, or the
-    /// rest of it.
+    /// rest of it. Only the rows of [`Assembler::rate_support`] are written (the others hold
+    /// whatever they held).
     pub fn rate_residual(&mut self, sys: &System, st: &State, aug: Augment, all: bool) {
-        self.residual.clear();
+        let r = &mut self.residual;
+        let support = if all {
+            &self.rate_support.1
+        } else {
+            &self.rate_support.0
+        };
+        for &i in support {
+            (r.inertia[i], r.force[i], r.constraint[i]) = (0.0, 0.0, 0.0);
+        }
         let first: &[usize] = if all { &self.reading.0 } else { &[] };
         for &e in first.iter().chain(&self.reading.1) {
             sys.elements[e].residual(st, aug, &mut self.residual);
@@ -232,6 +256,16 @@ impl Assembler {
             .0
             .iter()
             .any(|&e| matches!(sys.elements[e], Element::Beam(_)))
+    }
+
+    /// The unknowns of the elements [`Assembler::rate_residual`] evaluates: the rows it
+    /// writes, and the rates it reads.
+    pub fn rate_support(&self, all: bool) -> &[usize] {
+        if all {
+            &self.rate_support.1
+        } else {
+            &self.rate_support.0
+        }
     }
 
     /// Whether [`Assembler::rate_residual`] evaluates some element.

@@ -50,11 +50,12 @@ mod harmonics;
 mod space;
 
 use super::integrator::Integrator;
+use super::integrator::DEAD;
 use super::linear;
 use super::modes::c64;
 use super::{RuntimeFailure, Stop};
 use crate::runtime::{State, System};
-use crate::settings::Settings;
+use crate::settings::{Method, Settings};
 use nalgebra::DMatrix;
 use space::Space;
 use std::convert::Infallible;
@@ -130,6 +131,22 @@ fn integrate(it: &mut Integrator) -> Result<State, RuntimeFailure> {
             Stop::Stopped(never) => match never {},
         })?;
     Ok(it.state().clone())
+}
+
+/// Steps after which the integrator has damped a stiff mode's directions below
+/// [`DEAD`](crate::solve::integrator::DEAD) (its spectral radius at infinity to that power):
+/// the carried directions are deflated that often. 0 (never) for an integrator that does not
+/// damp them.
+fn deflation_steps(set: &Settings) -> usize {
+    let rho = match set.method {
+        Method::Hht => (1.0 + set.alpha) / (1.0 - set.alpha),
+        Method::GeneralizedAlpha => set.rho_inf,
+        Method::Fet | Method::Static => 1.0,
+    };
+    if rho.is_nan() || rho >= 0.99 {
+        return 0;
+    }
+    (DEAD.ln() / rho.max(1e-3).ln()).ceil() as usize
 }
 
 /// How the monodromy matrix is built.
@@ -298,6 +315,7 @@ fn by_tangent(
     })?;
     it.restart(&sys.initial).map_err(reference_failure)?;
     it.track(directions, 1.0 / space.omega);
+    it.deflate_every(deflation_steps(it.settings()));
     // The directions' measure at evenly spaced steps, for the modes' time histories.
     let stride = (it.steps() / harmonics::SAMPLES).max(1);
     let (t0, mut history) = (it.state().t, Vec::new());
@@ -332,8 +350,9 @@ fn carried_measure(
     space: &Space,
     reference: &State,
 ) -> DMatrix<f64> {
-    let (n, dim, nfree) = (space.dim(), it.direction_len(), space.free.len());
+    let (dim, nfree) = (it.direction_len(), space.free.len());
     let carried = it.tracked().unwrap_or_default();
+    let n = carried.len() / dim.max(1);
     // Each direction's weighted displacements and rates, then projected all at once.
     let (mut dq, mut dv) = (
         DMatrix::<f64>::zeros(nfree, n),
@@ -364,7 +383,9 @@ fn carried_measure(
             dv[(j, dir)] = (bv[j] - cv[j]) / (2.0 * e);
         }
     }
-    space.project(&dq, &dv)
+    let map = it.tracked_map().unwrap_or_default();
+    let given = map.len() / n.max(1);
+    space.project(&dq, &dv) * DMatrix::from_column_slice(n, given, map)
 }
 
 /// The monodromy's columns from `4 n_f` perturbed runs of one period.

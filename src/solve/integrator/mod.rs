@@ -10,6 +10,7 @@
 //!
 //! Rotations (THEORY §2.7, §7.1): [`Layout`] says how the rotation unknowns are held.
 
+mod deflate;
 mod fet;
 mod linearize;
 mod newmark;
@@ -24,6 +25,7 @@ mod tangent;
 #[cfg(test)]
 mod tests;
 
+pub use deflate::DEAD;
 pub use linearize::Linearization;
 
 use super::linear::{LinearError, SparseLu};
@@ -250,6 +252,10 @@ impl<'s> Integrator<'s> {
     /// The steps of a run (the settings').
     pub fn steps(&self) -> usize {
         self.set.steps
+    }
+
+    pub fn settings(&self) -> &Settings {
+        &self.set
     }
 
     pub fn augment(&self) -> Augment {

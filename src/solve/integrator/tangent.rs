@@ -43,19 +43,30 @@ pub(super) const ANALYTIC_ABOVE: usize = 16;
 pub(super) struct Tracked {
     /// Column-major `4 n x columns`.
     pub(super) columns: Vec<f64>,
-    count: usize,
+    pub(super) count: usize,
     /// Per unknown, the scale of its position (the length scale for coordinates that are not
     /// angles, 1 rad otherwise); rates are scaled by `tau`, accelerations by `tau^2`.
-    scale: Vec<f64>,
-    tau: f64,
+    pub(super) scale: Vec<f64>,
+    pub(super) tau: f64,
+    /// Column-major `count x original`: the directions given to [`Integrator::track`] are the
+    /// columns times it (the identity until [`Integrator::deflate`] drops some).
+    pub(super) map: Vec<f64>,
+    /// Deflate every this many steps (0: never), and the steps carried so far.
+    pub(super) deflate_every: usize,
+    pub(super) steps: usize,
     nodes: Vec<NodeMap>,
     dir: Vec<f64>,
     part: Vec<f64>,
     /// Each direction's velocities and accelerations as the state holds them (column-major
     /// `n x columns`).
-    physical: (Vec<f64>, Vec<f64>),
+    pub(super) physical: (Vec<f64>, Vec<f64>),
     /// Column-major `n x columns`: each direction's correction of the increment.
-    gradients: Vec<f64>,
+    pub(super) gradients: Vec<f64>,
+    /// Whether the elements with inertia take their assembled rate derivatives
+    /// ([`ANALYTIC_ABOVE`]); the unknowns of the elements differenced along the rates (the
+    /// rates they read, the rows they write), and the rotating nodes among them.
+    analytic: bool,
+    differenced: (Vec<usize>, Vec<usize>),
 }
 
 /// The Newmark relations as a matrix ([`Integrator::coefficients`]).
@@ -128,15 +139,16 @@ pub(super) fn perturb_rates(
     base: &State,
     dir: &[f64],
     eps: f64,
+    (unknowns, nodes): (&[usize], &[usize]),
     out: &mut State,
 ) {
     let n = sys.len();
-    for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
+    for &i in unknowns.iter().filter(|&&i| flat(sys, in_frame, i)) {
         out.v[i] = base.v[i] + eps * dir[n + i];
         out.a[i] = base.a[i] + eps * dir[2 * n + i];
         out.alg[i] = base.alg[i] + eps * dir[3 * n + i];
     }
-    for k in 0..sys.rotations.len() {
+    for &k in nodes {
         let (b, f) = (&base.frames[k], &mut out.frames[k]);
         for j in 0..6 {
             (f.v[j], f.dv[j], f.alg[j]) = match slot(sys, k, j) {
@@ -150,6 +162,15 @@ pub(super) fn perturb_rates(
         }
         se3::to_physical(sys, out, k);
     }
+}
+
+/// The rotating nodes with an unknown among `unknowns` (sorted).
+fn nodes_of(sys: &System, unknowns: &[usize]) -> Vec<usize> {
+    (0..sys.rotations.len())
+        .filter(|&k| {
+            (0..6).any(|j| slot(sys, k, j).is_some_and(|s| unknowns.binary_search(&s).is_ok()))
+        })
+        .collect()
 }
 
 /// The velocities and accelerations as `base` holds them (rotations: angular velocity and
@@ -235,10 +256,11 @@ pub(super) fn difference(sys: &System, in_frame: &[bool], a: &State, b: &State, 
 
 /// The scaled size of a direction's rates: the largest of its rates times `tau` and its
 /// accelerations times `tau^2`, over the position's scale.
-fn rate_size(scale: &[f64], tau: f64, dir: &[f64]) -> f64 {
+fn rate_size(scale: &[f64], tau: f64, dir: &[f64], on: &[usize]) -> f64 {
     let n = scale.len();
     let mut size = 0.0f64;
-    for (i, s) in scale.iter().enumerate() {
+    for &i in on {
+        let s = scale[i];
         size = size
             .max(tau * dir[n + i].abs() / s)
             .max(tau * tau * dir[2 * n + i].abs() / s);
@@ -276,22 +298,39 @@ impl Integrator<'_> {
         // next step's Newton keeps while it contracts (its first matrix costs nothing then),
         // whatever the settings' mode: the step converges to the same tolerance either way.
         self.reuse = Reuse::new(NewtonMode::Modified, self.method);
+        let analytic = count > ANALYTIC_ABOVE || self.asm.rates_need_derivatives(self.sys);
+        let on = self.asm.rate_support(!analytic).to_vec();
+        let differenced = (nodes_of(self.sys, &on), on);
+        let map = (0..count * count)
+            .map(|k| if k % (count + 1) == 0 { 1.0 } else { 0.0 })
+            .collect();
         self.tracked = Some(Box::new(Tracked {
             columns,
             count,
             scale,
             tau,
+            map,
+            deflate_every: 0,
+            steps: 0,
             nodes: vec![NodeMap::default(); nodes],
             dir: vec![0.0; 4 * n],
             part: vec![0.0; n],
             physical: (vec![0.0; n * count], vec![0.0; n * count]),
             gradients: vec![0.0; n * count],
+            analytic,
+            differenced: (differenced.1, differenced.0),
         }));
     }
 
     /// The carried directions at the current state.
     pub fn tracked(&self) -> Option<&[f64]> {
         self.tracked.as_ref().map(|t| t.columns.as_slice())
+    }
+
+    /// How the directions given to [`Integrator::track`] are made of the carried ones:
+    /// column-major `carried x given` (the identity but after [`Integrator::deflate`]).
+    pub fn tracked_map(&self) -> Option<&[f64]> {
+        self.tracked.as_ref().map(|t| t.map.as_slice())
     }
 
     /// `out = base (+) eps dir` in this integrator's state layout (see [`perturb`]).
@@ -442,7 +481,7 @@ impl Integrator<'_> {
         // Many directions, or beams: the elements with inertia through their derivatives,
         // assembled once; few on rigid bodies: every element that reads the rates by
         // differences.
-        let analytic = tk.count > ANALYTIC_ABOVE || self.asm.rates_need_derivatives(self.sys);
+        let analytic = tk.analytic;
         if analytic {
             self.asm.rate_jacobians(self.sys, &self.cur, aug);
         }
@@ -475,28 +514,34 @@ impl Integrator<'_> {
         }
         for c in 0..tk.count {
             let moved = &tk.columns[c * dim..(c + 1) * dim];
-            let size = rate_size(&tk.scale, tk.tau, moved);
-            if size == 0.0 {
-                continue;
-            }
-            let eps = EPSILON / size;
             let gradient = &mut tk.gradients[c * n..(c + 1) * n];
-            // The rest (joints with rate rows, or all) by central differences along the rates.
-            for sign in [1.0, -1.0].into_iter().filter(|_| differenced) {
+            // The rest (joints with rate rows, or all) by central differences along the rates,
+            // on the unknowns of the elements differenced (the rates they read, the rows they
+            // write).
+            let on = tk.differenced.0.as_slice();
+            let size = if differenced {
+                rate_size(&tk.scale, tk.tau, moved, on)
+            } else {
+                0.0
+            };
+            for sign in [1.0, -1.0].into_iter().filter(|_| size > 0.0) {
+                let eps = EPSILON / size;
+                let support = (on, tk.differenced.1.as_slice());
                 perturb_rates(
                     self.sys,
                     &self.in_frame,
                     &self.cur,
                     moved,
                     sign * eps,
+                    support,
                     &mut self.trial,
                 );
                 // Only the elements that read the rates: the others' parts cancel.
                 self.asm
                     .rate_residual(self.sys, &self.trial, aug, !analytic);
                 let r = &self.asm.residual;
-                for (i, g) in gradient.iter_mut().enumerate() {
-                    *g -= sign / (2.0 * eps)
+                for &i in on {
+                    gradient[i] -= sign / (2.0 * eps)
                         * if self.sys.unknowns[i].is_multiplier() {
                             aug.s * r.constraint[i]
                         } else {
@@ -516,6 +561,10 @@ impl Integrator<'_> {
             self.correct(&coef, &tk.nodes, &tk.gradients[c * n..(c + 1) * n], moved);
         }
         self.trial.assign(&self.cur);
+        tk.steps += 1;
+        if tk.deflate_every > 0 && tk.steps.is_multiple_of(tk.deflate_every) {
+            super::deflate::deflate(tk, n, h);
+        }
         Ok(())
     }
 }

@@ -358,12 +358,17 @@ fn the_rate_derivatives_are_the_residuals_along_the_rates() {
         let eps = 1e-2;
         let mut st = cur.clone();
         let mut ends = [vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]];
+        let every: (Vec<usize>, Vec<usize>) =
+            ((0..n).collect(), (0..sys.rotations.len()).collect());
         for (k, (sign, all)) in [(1.0, true), (-1.0, true), (1.0, false), (-1.0, false)]
             .into_iter()
             .enumerate()
         {
             st.assign(&cur);
-            super::tangent::perturb_rates(sys, &it.in_frame, &cur, &dir, sign * eps, &mut st);
+            let on = (every.0.as_slice(), every.1.as_slice());
+            super::tangent::perturb_rates(sys, &it.in_frame, &cur, &dir, sign * eps, on, &mut st);
+            // Rows outside the evaluated elements' unknowns are not written: zero them.
+            it.asm.residual.clear();
             it.asm.rate_residual(sys, &st, aug, all);
             for i in 0..n {
                 ends[k][i] = row(&it.asm.residual, i);
@@ -383,4 +388,62 @@ fn the_rate_derivatives_are_the_residuals_along_the_rates() {
             "{model}: {e:.3e} exceeds {bound:.1e}"
         );
     }
+}
+
+/// Deflation (`deflate.rs`) against the same directions carried whole: on the elastic windmill
+/// (2 elements per blade, stiff axial and shear modes), 160 directions over 400 steps, deflated
+/// every 100; the given directions rebuilt from the carried ones and the map, weighted as the
+/// deflation weighs them, relative to the largest. Measured 9.5e-10 with 59 of the 160 left.
+#[test]
+fn deflated_directions_rebuild_the_whole_ones() {
+    let sets = ["elements=2".to_string(), "Omega_bar=1.5".to_string()];
+    let c = compiled("windmill_elastic", &sets, Request::default());
+    let mut it = advanced(&c, 20);
+    let (sys, h) = (it.sys, c.settings.dt);
+    let n = sys.len();
+    let count = 160;
+    let mut dirs = vec![0.0; 4 * n * count];
+    for (k, d) in dirs.iter_mut().enumerate() {
+        let i = (k % (4 * n)) % n;
+        if !sys.unknowns[i].is_multiplier() && (k % (4 * n)) < 2 * n {
+            *d = ((k as u64 * 2654435761 + 5) % 1000) as f64 / 500.0 - 1.0;
+        }
+    }
+    let start = it.cur.clone();
+    let carry = |it: &mut Integrator, every: usize| {
+        it.cur.assign(&start);
+        it.track(dirs.clone(), 0.1);
+        it.deflate_every(every);
+        for _ in 0..400 {
+            it.advance(h, 0).map_err(|f| f.detail).unwrap();
+        }
+        let (cols, map) = (
+            it.tracked().unwrap().to_vec(),
+            it.tracked_map().unwrap().to_vec(),
+        );
+        (cols, map)
+    };
+    let (whole, _) = carry(&mut it, 0);
+    let (cols, map) = carry(&mut it, 100);
+    let kept = cols.len() / (4 * n);
+    assert!(kept < count, "nothing deflated");
+    let tk_scale = |i: usize| match sys.unknowns[i % n] {
+        crate::runtime::UnknownKind::Coordinate => sys.length_scale,
+        _ => 1.0,
+    };
+    let weight = |i: usize| [1.0, 0.1, h * h, h * h][i / n] / tk_scale(i);
+    let (mut worst, mut largest) = (0.0f64, 0.0f64);
+    for g in 0..count {
+        for i in 0..4 * n {
+            let rebuilt: f64 = (0..kept)
+                .map(|j| cols[j * 4 * n + i] * map[g * kept + j])
+                .sum();
+            let w = weight(i);
+            worst = worst.max(((rebuilt - whole[g * 4 * n + i]) * w).abs());
+            largest = largest.max((whole[g * 4 * n + i] * w).abs());
+        }
+    }
+    let e = worst / largest;
+    eprintln!("deflation: {kept} of {count} kept, rebuilt to {e:.2e}");
+    assert!(e < 3e-9, "{e:.3e}");
 }
