@@ -32,7 +32,9 @@ iteration matrices (the HHT and generalized-alpha integrators with incremental r
 runs of one period per direction). Exponents s = (ln|Lambda| + \
 i arg Lambda) / T. A multiplier gives the frequency only modulo 2 pi / T: with the tangent, \
 the frequency is the principal branch's plus the dominant harmonic of the mode's time history \
-over the period (the blades' frequency for a mode of a rotor's lag angles); --monodromy runs \
+over the period (the blades' frequency for a mode of a rigid-bladed rotor's lag angles; with elastic blades \
+without rotary inertia the nodes' inertial translations lead, and a lag mode may read as the \
+blades' frequency plus Omega); --monodromy runs \
 reports the principal branch, |Im s| <= pi / T.
 
 Prony (--method prony): the poles of a transient, the model's own run (its excitation \
