@@ -17,6 +17,9 @@ target/release/examples/windmill_mbc 4 > "$out/p5_mbc.csv"
     | tee "$out/p5_stability.txt"
 "$mbd" stability models/windmill.mbd --sweep Omega_bar=0.8:2.6:0.05 --refine 0 \
     --chart-kind campbell -o "$out/p5_campbell.csv" --chart "$out/p5_campbell.svg" > /dev/null
+"$mbd" stability models/windmill_elastic.mbd --set elements=2 --sweep Omega_bar=0.8:2.6:0.05 \
+    --method both --reference "$out/p5_mbc.csv" -o "$out/p5_elastic_stability.csv" \
+    --chart "$out/p5_elastic_stability.svg" | tail -3 > "$out/p5_elastic_stability.txt"
 
 for w in 1.0 2.0; do
     "$mbd" run models/windmill.mbd --set Omega_bar=$w --every 10 -o "$out/p5_windmill_$w.csv"

@@ -57,7 +57,9 @@ empty cells where a point failed), then mode1_freq,mode1_real,mode1_damping,...:
 followed along the grid (per method), a stable column per mode: each mode continues the one \
 of the previous value whose shape it matches best (the modal assurance criterion; Prony's \
 poles, which have no shape, by the nearest exponent). --chart-kind real (the default) plots \
-the real parts against the param, the largest as a line, with the unstable ranges shaded; \
+the real parts against the param, the largest as a line, with the unstable ranges shaded \
+(modes damped below three times the grid's largest |Re s| are left off the chart, not the \
+CSV); \
 --chart-kind campbell the Campbell diagram: each followed mode's frequency with the \
 per-revolution lines n Omega, and below it its real part, the unstable ranges shaded. \
 --reference FILE.csv adds the columns of a CSV (its first column the param) as lines on the \

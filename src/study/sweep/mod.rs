@@ -32,6 +32,10 @@ use std::sync::Mutex;
 pub type CompileWith<'a, E = super::CompileError> =
     dyn Fn(&[String]) -> Result<Compiled, E> + Sync + 'a;
 
+/// The chart of real parts shows modes down to this many times the largest modulus of the
+/// points' largest real parts (or of the threshold).
+pub const CHART_REACH: f64 = 3.0;
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Method {
     Floquet,
@@ -422,7 +426,8 @@ impl Sweep {
         out
     }
 
-    /// Real parts against the param: every mode's as markers, the largest as a line per method,
+    /// Real parts against the param: every mode's as markers (down to [`CHART_REACH`] times
+    /// the largest modulus of a point's largest real part), the largest as a line per method,
     /// the unstable ranges shaded, `reference` series (e.g. multiblade eigenvalues) on top.
     pub fn chart(&self, title: &str, reference: Vec<Series>) -> Chart {
         let mut series = Vec::new();
@@ -432,6 +437,14 @@ impl Sweep {
                 methods.push(p.method);
             }
         }
+        // Modes damped far below the largest growth rates (a beam's stiff modes, which the
+        // integrator damps at tens of 1/s) are left off the markers: they stay in the CSV.
+        let reach = (self.points.iter())
+            .filter(|p| p.failure.is_none())
+            .map(|p| p.max_real().abs())
+            .filter(|x| x.is_finite())
+            .fold(self.threshold, f64::max);
+        let floor = -CHART_REACH * reach;
         for m in &methods {
             let mut all: Vec<&Point> = self
                 .points
@@ -450,6 +463,7 @@ impl Sweep {
                 points: all
                     .iter()
                     .flat_map(|p| p.modes.iter().map(move |s| (p.value, s.re)))
+                    .filter(|&(_, re)| re >= floor)
                     .collect(),
                 markers_only: true,
             });
@@ -465,5 +479,47 @@ impl Sweep {
             shaded: self.unstable_ranges(),
             guides: Vec::new(),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The chart's markers reach down to three times the largest growth rate's modulus: a
+    /// stiff mode at -100 1/s is left off (it stays in the CSV), a mode at -2 is drawn.
+    #[test]
+    fn the_chart_leaves_off_modes_damped_far_below_the_growth_rates() {
+        let point = |value: f64| Point {
+            value,
+            method: Method::Floquet,
+            modes: vec![
+                c64::new(1.0, 5.0),
+                c64::new(-2.0, 5.0),
+                c64::new(-100.0, 90.0),
+            ],
+            shapes: Vec::new(),
+            tracks: Vec::new(),
+            rotor_speed: f64::NAN,
+            failure: None,
+            cpu_s: 0.0,
+            detail: String::new(),
+        };
+        let sweep = Sweep {
+            param: "Omega_bar".into(),
+            points: vec![point(1.0), point(2.0)],
+            refinements: Vec::new(),
+            edges: Vec::new(),
+            threshold: 0.01,
+            notes: Vec::new(),
+        };
+        let chart = sweep.chart("t", Vec::new());
+        let markers = chart
+            .series
+            .iter()
+            .find(|s| s.label == "Re s of each mode (floquet)")
+            .expect("markers");
+        let reals: Vec<f64> = markers.points.iter().map(|p| p.1).collect();
+        assert_eq!(reals, vec![1.0, -2.0, 1.0, -2.0]);
     }
 }
