@@ -29,7 +29,10 @@ inertia; positions without inertia, such as the rotations of beam nodes without 
 follow the others in equilibrium) carried through one run of the period by the converged steps' \
 iteration matrices (the HHT and generalized-alpha integrators with incremental rotations; \
 --monodromy runs, time finite elements and conformal rotations build it from two perturbed \
-runs of one period per direction). Exponents s = (ln|Lambda| + \
+runs of one period per direction). With the tangent and a damping integrator the multipliers \
+are the discrete map's own: the run goes on past the period by the steps that damp the \
+algorithmic part, and the directions not damped out are projected on themselves over a \
+period from there (the consistent start's accelerations do not enter). Exponents s = (ln|Lambda| + \
 i arg Lambda) / T. A multiplier gives the frequency only modulo 2 pi / T: with the tangent, \
 the frequency is the principal branch's plus the dominant harmonic of the mode's time history \
 over the period (the blades' frequency for a mode of a rigid-bladed rotor's lag angles; with elastic blades \

@@ -33,14 +33,26 @@
 //!    `|Im s| <= pi / T` (known only modulo `2 pi / T`).
 //!
 //! The step's own state: HHT and generalized-alpha carry `a` and `A`, so the discrete map
-//! lives in `(q, v, a, A)`, twice the dimension of `z`. Both monodromies chain the
-//! sensitivities through the consistent start (accelerations as functions of `(q, v)` at
-//! `t = 0`) and carry the whole step state inside the period, measuring `(q, v)` at its end.
-//! The discrete map's extra multipliers are algorithmic: an HHT or generalized-alpha step
-//! damps them by `rho_inf` (0.82 at alpha -0.1), so over the `N` steps of a period (hundreds)
-//! their share of `Z_T` is `rho_inf^N` (1e-79 on the windmill): `Phi` is the physical block of
-//! the discrete monodromy to that order, and no algorithmic multiplier needs separating.
-//!
+//! lives in `(q, v, a, A)`, twice the dimension of `z`. `Phi` chains the sensitivities through
+//! the consistent start (accelerations as functions of `(q, v)` at `t = 0`) and carries the
+//! whole step state inside the period, measuring `(q, v)` at its end. The discrete map's extra
+//! multipliers are algorithmic: the step damps them by `rho_inf` (0.82 at alpha -0.1), so over
+//! the `N` steps of a period their share of `Z_T` is `rho_inf^N`. But the start's accelerations
+//! are not the discrete motion's: for a beam's stiff axial and shear modes they differ by
+//! orders of magnitude, and the multipliers of `Phi` carry that error once (the elastic
+//! windmill: 3.5e-4 relative at 0.5 ms, 2.7e-3 at 1 ms, against the discrete motion's own
+//! growth). So with the tangent and a damping integrator the multipliers are the discrete
+//! map's own (`Settled`): the run goes on for the settling steps past the period; after them
+//! (the algorithmic part at 1e-10) the carried directions that are not damped out are made
+//! orthonormal in the weighted step state (`integrator/deflate.rs`), carried one period on, and
+//! the map's Rayleigh-Ritz projection on them, `U^T W S`, gives the multipliers: its subspace
+//! holds the slow invariant one, so they are exact, and no start enters (the elastic windmill:
+//! 1.6e-5 from the multiblade equations with stiff blades; the undamped rigid windmill's
+//! neutral modes at 1e-9 1/s instead of 8.5e-7). `Phi` (through the start) stays the
+//! reported monodromy matrix, which perturbed runs build the same way, and guards the
+//! projection: a largest multiplier above `Phi`'s by 1 % would be a Ritz value of the damped
+//! directions, and `Phi`'s multipliers are reported then.
+
 //! The reference is the model's own motion from its initial state, loads included: a pulse that
 //! acts in the first period is in every run and cancels in the differences (to first order
 //! in its size). The monodromy matrix is that of the discrete map, so its damping carries the
@@ -149,6 +161,10 @@ fn deflation_steps(set: &Settings) -> usize {
     (DEAD.ln() / rho.max(1e-3).ln()).ceil() as usize
 }
 
+/// The settled projection's largest multiplier may exceed that of `Phi` (through the
+/// consistent start) by this share; beyond it, `Phi`'s multipliers are reported.
+const RITZ_GUARD: f64 = 1e-2;
+
 /// How the monodromy matrix is built.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Monodromy {
@@ -194,6 +210,7 @@ pub fn floquet_by(
         zt,
         newton_iterations,
         history,
+        settled,
     } = match how {
         Monodromy::Tangent => by_tangent(sys, &mut it, &space, progress)?,
         Monodromy::Runs => by_runs(sys, &mut it, &space, progress)?,
@@ -213,7 +230,27 @@ pub fn floquet_by(
         }
     };
     let phi: Vec<f64> = (0..n * n).map(|k| phi_m[(k % n, k / n)]).collect();
-    let modes = eigen(&phi, n).ok_or_else(|| {
+    // The multipliers: of the discrete map itself where the tangent settled, else of `Phi`.
+    // A settled projection whose largest multiplier exceeds `Phi`'s by more than `RITZ_GUARD`
+    // holds a Ritz value of the damped-out directions, not a mode: `Phi` is used then.
+    let largest = |m: &[f64], n: usize| {
+        eigen(m, n).map_or(f64::INFINITY, |e| {
+            e.first().map_or(0.0, |(l, _)| l.re.hypot(l.im))
+        })
+    };
+    let settled = settled.filter(|st| {
+        largest(st.c.as_slice(), st.c.nrows()) <= (1.0 + RITZ_GUARD) * largest(&phi, n)
+    });
+    let (matrix, r, history, z0) = match &settled {
+        Some(st) => (
+            st.c.as_slice().to_vec(),
+            st.c.nrows(),
+            &st.history,
+            DMatrix::identity(st.c.nrows(), st.c.nrows()),
+        ),
+        None => (phi.clone(), n, &history, z0),
+    };
+    let modes = eigen(&matrix, r).ok_or_else(|| {
         reference_failure(RuntimeFailure {
             kind: super::FailureKind::Singular,
             t: period,
@@ -222,8 +259,21 @@ pub fn floquet_by(
             detail: "the eigenvalues of the monodromy matrix could not be computed".into(),
         })
     })?;
+    // Eigenvectors in the measure `z` (the settled directions' measure times theirs).
+    let in_z = |v: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        match &settled {
+            Some(st) => {
+                let part = |pick: fn(&(f64, f64)) -> f64| {
+                    &st.z * DMatrix::from_iterator(v.len(), 1, v.iter().map(pick))
+                };
+                let (re, im) = (part(|x| x.0), part(|x| x.1));
+                re.iter().zip(im.iter()).map(|(&a, &b)| (a, b)).collect()
+            }
+            None => v.to_vec(),
+        }
+    };
     let multipliers: Vec<c64> = modes.iter().map(|(m, _)| *m).collect();
-    let shapes = modes.iter().map(|(_, v)| space.shape(v)).collect();
+    let shapes = modes.iter().map(|(_, v)| space.shape(&in_z(v))).collect();
     let exponents: Vec<c64> = multipliers.iter().map(|&m| exponent(m, period)).collect();
     let principal = || exponents.iter().map(|s| s.im).collect();
     let frequencies = if history.len() > 2 {
@@ -232,7 +282,7 @@ pub fn floquet_by(
             .zip(modes)
             .map(|(s, (_, v))| ((s.re, s.im), v))
             .collect();
-        harmonics::resolve(&history, &z0, &shapes, period).unwrap_or_else(principal)
+        harmonics::resolve(history, &z0, &shapes, period).unwrap_or_else(principal)
     } else {
         principal()
     };
@@ -257,6 +307,17 @@ struct Columns {
     z0: DMatrix<f64>,
     zt: DMatrix<f64>,
     newton_iterations: usize,
+    history: Vec<(f64, DMatrix<f64>)>,
+    /// From the tangent with a damping integrator: the discrete map's own monodromy.
+    settled: Option<Settled>,
+}
+
+/// The monodromy projected on the directions the integrator kept after the settling steps
+/// (`integrator/deflate.rs`), over one period from them: `c` (`r x r`), the measure `z` of
+/// those directions (`n x r`), and their history over the period.
+struct Settled {
+    c: DMatrix<f64>,
+    z: DMatrix<f64>,
     history: Vec<(f64, DMatrix<f64>)>,
 }
 
@@ -315,17 +376,39 @@ fn by_tangent(
     })?;
     it.restart(&sys.initial).map_err(reference_failure)?;
     it.track(directions, 1.0 / space.omega);
-    it.deflate_every(deflation_steps(it.settings()));
+    // With a damping integrator, the run goes on past the period by the settling steps, and
+    // the period is measured again from them (`Settled`).
+    let (period, settle) = (it.steps(), deflation_steps(it.settings()));
+    it.deflate_every(settle, true);
+    it.extend_run(settle);
     // The directions' measure at evenly spaced steps, for the modes' time histories.
-    let stride = (it.steps() / harmonics::SAMPLES).max(1);
+    let stride = (period / harmonics::SAMPLES).max(1);
     let (t0, mut history) = (it.state().t, Vec::new());
     history.push((0.0, z0.clone()));
+    let mut zt = None;
+    let (mut from, mut settled) = (None, None);
+    let mut rr_history = Vec::new();
     it.run(|k, it| {
-        if k % stride == 0 && k < it.steps() {
-            history.push((
-                it.state().t - t0,
-                carried_measure(sys, it, space, it.state()),
-            ));
+        let t = it.state().t;
+        // (The settled history replaces it.)
+        if settle == 0 && k % stride == 0 && k < period {
+            history.push((t - t0, carried_measure(sys, it, space, it.state())));
+        }
+        if k == period {
+            zt = Some(carried_measure(sys, it, space, it.state()));
+        }
+        match from {
+            None if it.is_settled() => {
+                from = Some((k, t));
+                rr_history.push((0.0, carried_settled(sys, it, space)));
+            }
+            Some((s, ts)) if k - s < period && (k - s) % stride == 0 => {
+                rr_history.push((t - ts, carried_settled(sys, it, space)));
+            }
+            Some((s, _)) if k - s == period => {
+                settled = it.settled_monodromy();
+            }
+            _ => {}
         }
         Ok::<(), Infallible>(())
     })
@@ -334,12 +417,21 @@ fn by_tangent(
         Stop::Stopped(never) => match never {},
     })?;
     progress();
-    let zt = carried_measure(sys, it, space, it.state());
+    let zt = zt.unwrap_or_else(|| carried_measure(sys, it, space, it.state()));
+    let settled = settled.and_then(|c| {
+        let z = rr_history.first()?.1.clone();
+        Some(Settled {
+            c,
+            z,
+            history: rr_history,
+        })
+    });
     Ok(Columns {
         z0,
         zt,
         newton_iterations: it.stats().newton_iterations,
         history,
+        settled,
     })
 }
 
@@ -350,6 +442,15 @@ fn carried_measure(
     space: &Space,
     reference: &State,
 ) -> DMatrix<f64> {
+    let raw = carried_raw(sys, it, space, reference);
+    let n = raw.ncols();
+    let map = it.tracked_map().unwrap_or_default();
+    let given = map.len() / n.max(1);
+    raw * DMatrix::from_column_slice(n, given, map)
+}
+
+/// The measure of each carried column at the integrator's current state `reference`.
+fn carried_raw(sys: &System, it: &Integrator, space: &Space, reference: &State) -> DMatrix<f64> {
     let (dim, nfree) = (it.direction_len(), space.free.len());
     let carried = it.tracked().unwrap_or_default();
     let n = carried.len() / dim.max(1);
@@ -383,9 +484,16 @@ fn carried_measure(
             dv[(j, dir)] = (bv[j] - cv[j]) / (2.0 * e);
         }
     }
-    let map = it.tracked_map().unwrap_or_default();
-    let given = map.len() / n.max(1);
-    space.project(&dq, &dv) * DMatrix::from_column_slice(n, given, map)
+    space.project(&dq, &dv)
+}
+
+/// The measure of the settled directions' images now (`integrator/deflate.rs`).
+fn carried_settled(sys: &System, it: &Integrator, space: &Space) -> DMatrix<f64> {
+    let raw = carried_raw(sys, it, space, it.state());
+    let since = it.settled_images().unwrap_or_default();
+    let n = raw.ncols();
+    let r = since.len() / n.max(1);
+    raw * DMatrix::from_column_slice(n, r, since)
 }
 
 /// The monodromy's columns from `4 n_f` perturbed runs of one period.
@@ -418,6 +526,7 @@ fn by_runs(
         zt,
         newton_iterations,
         history: Vec::new(),
+        settled: None,
     })
 }
 

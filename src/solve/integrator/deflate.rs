@@ -11,6 +11,7 @@
 use super::tangent::Tracked;
 use super::Integrator;
 use crate::solve::linear::svd_right;
+use nalgebra::DMatrix;
 
 /// Singular values of the weighted columns below this are dropped (the directions start at
 /// unit size): what they carry reaches the measure at the end at about this size times the
@@ -19,22 +20,58 @@ pub const DEAD: f64 = 1e-10;
 
 impl Integrator<'_> {
     /// Deflates the carried directions every `every` steps from now on (0: never), while a
-    /// pass drops some.
-    pub fn deflate_every(&mut self, every: usize) {
+    /// pass drops some; with `settle`, the first pass also makes the columns orthonormal
+    /// (weighted) and keeps them: [`Integrator::settled_monodromy`] then projects their images.
+    pub fn deflate_every(&mut self, every: usize, settle: bool) {
         if let Some(tk) = self.tracked.as_mut() {
             tk.deflate_every = every;
+            tk.settle = settle && every > 0;
         }
     }
+
+    /// Whether the settling pass has run.
+    pub fn is_settled(&self) -> bool {
+        self.tracked.as_ref().is_some_and(|t| !t.settled.is_empty())
+    }
+
+    /// The current columns' combinations that are the images of the settled ones (column-major
+    /// `carried x settled`).
+    pub fn settled_images(&self) -> Option<&[f64]> {
+        let tk = self.tracked.as_ref()?;
+        (!tk.settled.is_empty()).then_some(tk.since.as_slice())
+    }
+
+    /// The map's Rayleigh-Ritz projection on the settled columns `U` (orthonormal in the
+    /// weighted state): `U^T W S`, `S` their images now. Over a period from the settling pass,
+    /// its eigenvalues are the multipliers of the discrete map whose directions the pass kept.
+    pub fn settled_monodromy(&self) -> Option<DMatrix<f64>> {
+        let tk = self.tracked.as_ref()?;
+        if tk.settled.is_empty() {
+            return None;
+        }
+        let n = self.sys.len();
+        let dim = 4 * n;
+        let r = tk.settled.len() / dim;
+        let w = |i: usize| weight(tk, n, tk.h, i);
+        let u = DMatrix::from_fn(dim, r, |i, j| tk.settled[j * dim + i] * w(i));
+        let now = DMatrix::from_fn(dim, tk.count, |i, j| tk.columns[j * dim + i] * w(i));
+        let since = DMatrix::from_column_slice(tk.count, r, &tk.since);
+        Some(u.transpose() * now * since)
+    }
+}
+
+/// The weight of slot `i` of a direction (`n` unknowns, steps of `h`): positions over their
+/// scale, rates times the motion's time scale, accelerations times `h^2`.
+fn weight(tk: &Tracked, n: usize, h: f64, i: usize) -> f64 {
+    [1.0, tk.tau, h * h, h * h][i / n] / tk.scale[i % n]
 }
 
 /// One pass over `tk` (`n` unknowns, steps of `h`): the columns' weighted singular value
 /// decomposition, the live combinations kept; deflation stops once a pass drops none.
 pub(super) fn deflate(tk: &mut Tracked, n: usize, h: f64) {
     let (dim, count) = (4 * n, tk.count);
-    let weight = |i: usize| {
-        let level = [1.0, tk.tau, h * h, h * h][i / n];
-        level / tk.scale[i % n]
-    };
+    let weights: Vec<f64> = (0..dim).map(|i| weight(tk, n, h, i)).collect();
+    let weight = |i: usize| weights[i];
     // Row-major `dim x count`.
     let mut a = vec![0.0; dim * count];
     for c in 0..count {
@@ -47,7 +84,8 @@ pub(super) fn deflate(tk: &mut Tracked, n: usize, h: f64) {
         return;
     };
     let keep = values.iter().filter(|&&s| s > DEAD).count();
-    if keep == count || keep == 0 {
+    let settling = tk.settle && tk.settled.is_empty();
+    if (keep == count && !settling) || keep == 0 {
         tk.deflate_every = 0;
         return;
     }
@@ -69,6 +107,35 @@ pub(super) fn deflate(tk: &mut Tracked, n: usize, h: f64) {
         for j in 0..keep {
             map[g * keep + j] = (0..count).map(|i| v(i, j) * tk.map[g * count + i]).sum();
         }
+    }
+    // The settled columns' images: the dropped part aside, the old columns are the new ones
+    // times V_r^T.
+    if !tk.settled.is_empty() {
+        let r = tk.since.len() / count;
+        let mut since = vec![0.0; keep * r];
+        for g in 0..r {
+            for j in 0..keep {
+                since[g * keep + j] = (0..count).map(|i| v(i, j) * tk.since[g * count + i]).sum();
+            }
+        }
+        tk.since = since;
+    }
+    if settling {
+        // The settled directions, orthonormal in the weighted state: W S V_r = Q R gives
+        // W^-1 Q, whose images are the carried columns' times R^-1 (upper triangular: the
+        // directions kept first, the slow ones, never take the others' parts). The carried
+        // columns stay S V_r, so later passes drop what decays as before.
+        let wc = DMatrix::from_fn(dim, keep, |i, j| columns[j * dim + i] * weight(i));
+        let qr = wc.qr();
+        let (q, r) = (qr.q(), qr.r());
+        let Some(inverse) = r.solve_upper_triangular(&DMatrix::identity(keep, keep)) else {
+            tk.settle = false;
+            return;
+        };
+        tk.settled = (0..keep * dim)
+            .map(|k| q[(k % dim, k / dim)] / weight(k % dim))
+            .collect();
+        tk.since = inverse.as_slice().to_vec();
     }
     tk.columns = columns;
     tk.map = map;

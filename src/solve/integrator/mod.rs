@@ -258,6 +258,12 @@ impl<'s> Integrator<'s> {
         &self.set
     }
 
+    /// Lengthens the run by `extra` steps of its size.
+    pub fn extend_run(&mut self, extra: usize) {
+        self.set.steps += extra;
+        self.set.until += extra as f64 * self.set.dt;
+    }
+
     pub fn augment(&self) -> Augment {
         self.aug
     }

@@ -54,6 +54,13 @@ pub(super) struct Tracked {
     /// Deflate every this many steps (0: never), and the steps carried so far.
     pub(super) deflate_every: usize,
     pub(super) steps: usize,
+    /// Whether the first deflation settles ([`Integrator::deflate_every`]); then its
+    /// orthonormal columns (`U`, weighted), and the current columns' combinations that are
+    /// their images (column-major `count x settled`), and the last step's size.
+    pub(super) settle: bool,
+    pub(super) settled: Vec<f64>,
+    pub(super) since: Vec<f64>,
+    pub(super) h: f64,
     nodes: Vec<NodeMap>,
     dir: Vec<f64>,
     part: Vec<f64>,
@@ -312,6 +319,10 @@ impl Integrator<'_> {
             map,
             deflate_every: 0,
             steps: 0,
+            settle: false,
+            settled: Vec::new(),
+            since: Vec::new(),
+            h: 0.0,
             nodes: vec![NodeMap::default(); nodes],
             dir: vec![0.0; 4 * n],
             part: vec![0.0; n],
@@ -562,6 +573,7 @@ impl Integrator<'_> {
         }
         self.trial.assign(&self.cur);
         tk.steps += 1;
+        tk.h = h;
         if tk.deflate_every > 0 && tk.steps.is_multiple_of(tk.deflate_every) {
             super::deflate::deflate(tk, n, h);
         }
