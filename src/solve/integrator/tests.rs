@@ -390,25 +390,39 @@ fn the_rate_derivatives_are_the_residuals_along_the_rates() {
     }
 }
 
+/// The elastic windmill, 2 elements per blade, in the ground-resonance band.
+fn elastic_windmill() -> crate::Compiled {
+    let sets = ["elements=2".to_string(), "Omega_bar=1.5".to_string()];
+    compiled("windmill_elastic", &sets, Request::default())
+}
+
+/// `count` directions of `4 n` slots, pseudo-random in `[-1, 1)` on the positions and rates of
+/// the unknowns that are not multipliers (`skip`), zero on the accelerations.
+fn spread_directions(n: usize, count: usize, skip: impl Fn(usize) -> bool) -> Vec<f64> {
+    (0..4 * n * count)
+        .map(|k| {
+            let i = (k % (4 * n)) % n;
+            if skip(i) || k % (4 * n) >= 2 * n {
+                0.0
+            } else {
+                ((k as u64 * 2654435761 + 5) % 1000) as f64 / 500.0 - 1.0
+            }
+        })
+        .collect()
+}
+
 /// Deflation (`deflate.rs`) against the same directions carried whole: on the elastic windmill
 /// (2 elements per blade, stiff axial and shear modes), 160 directions over 400 steps, deflated
 /// every 100; the given directions rebuilt from the carried ones and the map, weighted as the
 /// deflation weighs them, relative to the largest. Measured 9.5e-10 with 59 of the 160 left.
 #[test]
 fn deflated_directions_rebuild_the_whole_ones() {
-    let sets = ["elements=2".to_string(), "Omega_bar=1.5".to_string()];
-    let c = compiled("windmill_elastic", &sets, Request::default());
+    let c = elastic_windmill();
     let mut it = advanced(&c, 20);
     let (sys, h) = (it.sys, c.settings.dt);
     let n = sys.len();
     let count = 160;
-    let mut dirs = vec![0.0; 4 * n * count];
-    for (k, d) in dirs.iter_mut().enumerate() {
-        let i = (k % (4 * n)) % n;
-        if !sys.unknowns[i].is_multiplier() && (k % (4 * n)) < 2 * n {
-            *d = ((k as u64 * 2654435761 + 5) % 1000) as f64 / 500.0 - 1.0;
-        }
-    }
+    let dirs = spread_directions(n, count, |i| sys.unknowns[i].is_multiplier());
     let start = it.cur.clone();
     let carry = |it: &mut Integrator, every: usize| {
         it.cur.assign(&start);
@@ -454,19 +468,12 @@ fn deflated_directions_rebuild_the_whole_ones() {
 /// on, in the same weights. Measured 4.7e-9 relative to the largest entry.
 #[test]
 fn the_settled_monodromy_is_the_settled_directions_carried_whole() {
-    let sets = ["elements=2".to_string(), "Omega_bar=1.5".to_string()];
-    let c = compiled("windmill_elastic", &sets, Request::default());
+    let c = elastic_windmill();
     let mut it = advanced(&c, 20);
     let (sys, h) = (it.sys, c.settings.dt);
     let n = sys.len();
     let count = 160;
-    let mut dirs = vec![0.0; 4 * n * count];
-    for (k, d) in dirs.iter_mut().enumerate() {
-        let i = (k % (4 * n)) % n;
-        if !sys.unknowns[i].is_multiplier() && (k % (4 * n)) < 2 * n {
-            *d = ((k as u64 * 2654435761 + 5) % 1000) as f64 / 500.0 - 1.0;
-        }
-    }
+    let dirs = spread_directions(n, count, |i| sys.unknowns[i].is_multiplier());
     let tau = 0.1;
     it.track(dirs, tau);
     it.deflate_every(100, true);
