@@ -8,17 +8,26 @@ use crate::common::{read, within};
 use mbd::settings::Request;
 use mbd::solve::floquet::{floquet_by, Floquet, Monodromy};
 
-fn both(path: &str, sets: &[&str], period: Option<f64>) -> (Floquet, Floquet) {
+/// A model of `models/` compiled with `sets`.
+fn compiled(path: &str, sets: &[&str]) -> mbd::Compiled {
     let sets: Vec<String> = sets.iter().map(|s| s.to_string()).collect();
-    let c = mbd::compile(path, &read(path), &sets, Request::default())
+    mbd::compile(path, &read(path), &sets, Request::default())
         .map_err(|f| format!("{:?}", f.diagnostics))
-        .unwrap();
-    let sys = &c
-        .lowered
+        .unwrap()
+}
+
+/// Its runnable system.
+fn system(c: &mbd::Compiled) -> &mbd::runtime::System {
+    &c.lowered
         .as_ref()
         .map_err(|d| d.message.clone())
         .unwrap()
-        .system;
+        .system
+}
+
+fn both(path: &str, sets: &[&str], period: Option<f64>) -> (Floquet, Floquet) {
+    let c = compiled(path, sets);
+    let sys = system(&c);
     let period = period.unwrap_or_else(|| mbd::study::sweep::rotor_period(&c).unwrap());
     let by = |how| {
         floquet_by(sys, &c.settings, period, how, &|| {})
@@ -269,18 +278,10 @@ fn the_tangent_monodromy_of_the_elastic_windmill_is_that_of_perturbed_runs() {
 #[test]
 fn the_elastic_windmill_grows_as_the_multiblade_equations_and_converges_with_elements() {
     let growth_of = |sets: &[&str]| {
-        let (path, mut all) = ("models/windmill_elastic.mbd", vec!["Omega_bar=1.5"]);
+        let mut all = vec!["Omega_bar=1.5"];
         all.extend_from_slice(sets);
-        let sets: Vec<String> = all.iter().map(|s| s.to_string()).collect();
-        let c = mbd::compile(path, &read(path), &sets, Request::default())
-            .map_err(|f| format!("{:?}", f.diagnostics))
-            .unwrap();
-        let sys = &c
-            .lowered
-            .as_ref()
-            .map_err(|d| d.message.clone())
-            .unwrap()
-            .system;
+        let c = compiled("models/windmill_elastic.mbd", &all);
+        let sys = system(&c);
         let period = mbd::study::sweep::rotor_period(&c).unwrap();
         let f = floquet_by(sys, &c.settings, period, Monodromy::Tangent, &|| {})
             .map_err(|f| format!("{:?}", f.failure))

@@ -374,31 +374,11 @@ pub fn generalized_eigen(
     )
     .ok()?;
     let (re, im, beta) = (re.column_vector(), im.column_vector(), beta.column_vector());
-    // Complex pairs occupy two columns: the real and the imaginary part of the first.
-    let mut out = Vec::with_capacity(n);
-    let mut j = 0;
-    while j < n {
-        if im[j] == 0.0 || j + 1 == n {
-            out.push((
-                (re[j], 0.0),
-                (beta[j], 0.0),
-                (0..n).map(|i| (u[(i, j)], 0.0)).collect(),
-            ));
-            j += 1;
-        } else {
-            out.push((
-                (re[j], im[j]),
-                (beta[j], 0.0),
-                (0..n).map(|i| (u[(i, j)], u[(i, j + 1)])).collect(),
-            ));
-            out.push((
-                (re[j], -im[j]),
-                (beta[j], 0.0),
-                (0..n).map(|i| (u[(i, j)], -u[(i, j + 1)])).collect(),
-            ));
-            j += 2;
-        }
-    }
+    let pairs = conjugate_pairs(n, |j| (re[j], im[j]), |i, j| u[(i, j)]);
+    let out = pairs
+        .into_iter()
+        .map(|(j, value, v)| (value, (beta[j], 0.0), v))
+        .collect();
     Some(out)
 }
 
@@ -438,22 +418,36 @@ pub fn eigen(a: &[f64], n: usize) -> Option<Vec<((f64, f64), Vec<(f64, f64)>)>> 
     )
     .ok()?;
     let (re, im) = (re.column_vector(), im.column_vector());
-    // Complex pairs occupy two columns: the real and the imaginary part of the first.
+    let pairs = conjugate_pairs(n, |j| (re[j], im[j]), |i, j| u[(i, j)]);
+    let out = pairs.into_iter().map(|(_, value, v)| (value, v)).collect();
+    Some(out)
+}
+
+/// Real eigendecompositions' output as complex pairs: eigenvalue `j` (`value(j)`, a pair
+/// occupying two columns of `u`: the real and the imaginary part of the first) with its
+/// column index, value and eigenvector; conjugates follow each other.
+#[allow(clippy::type_complexity)]
+fn conjugate_pairs(
+    n: usize,
+    value: impl Fn(usize) -> (f64, f64),
+    u: impl Fn(usize, usize) -> f64,
+) -> Vec<(usize, (f64, f64), Vec<(f64, f64)>)> {
     let mut out = Vec::with_capacity(n);
     let mut j = 0;
     while j < n {
-        if im[j] == 0.0 || j + 1 == n {
-            out.push(((re[j], 0.0), (0..n).map(|i| (u[(i, j)], 0.0)).collect()));
+        let (re, im) = value(j);
+        if im == 0.0 || j + 1 == n {
+            out.push((j, (re, 0.0), (0..n).map(|i| (u(i, j), 0.0)).collect()));
             j += 1;
         } else {
-            let v: Vec<(f64, f64)> = (0..n).map(|i| (u[(i, j)], u[(i, j + 1)])).collect();
+            let v: Vec<(f64, f64)> = (0..n).map(|i| (u(i, j), u(i, j + 1))).collect();
             let conjugate = v.iter().map(|&(x, y)| (x, -y)).collect();
-            out.push(((re[j], im[j]), v));
-            out.push(((re[j], -im[j]), conjugate));
+            out.push((j, (re, im), v));
+            out.push((j, (re, -im), conjugate));
             j += 2;
         }
     }
-    Some(out)
+    out
 }
 
 #[cfg(test)]
