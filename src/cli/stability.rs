@@ -38,7 +38,11 @@ the frequency is the principal branch's plus the dominant harmonic of the mode's
 over the period (the blades' frequency for a mode of a rigid-bladed rotor's lag angles; with elastic blades \
 without rotary inertia the nodes' inertial translations lead, and a lag mode may read as the \
 blades' frequency plus Omega); --monodromy runs \
-reports the principal branch, |Im s| <= pi / T.
+reports the principal branch, |Im s| <= pi / T. Partial Floquet (--modes K): the K multipliers \
+of largest modulus alone, by block Arnoldi on the same map, each block of K + 4 directions \
+carried through a run of the period until the wanted ones converge; a run per block, so \
+more CPU than the whole analysis on the models measured but a fraction of its memory (chosen \
+by itself where the whole analysis would carry more than 2 GiB of directions).
 
 Prony (--method prony): the poles of a transient, the model's own run (its excitation \
 included), fitted by the matrix pencil method over --window (default: from a tenth of the run \
@@ -91,6 +95,13 @@ pub struct StabilityArgs {
     /// runs (4 n_f + 1 runs of a period; the cross-check).
     #[arg(long, value_enum, default_value = "tangent")]
     monodromy: MonodromyArg,
+    /// Floquet: partial analysis, the K multipliers of largest modulus (the least stable
+    /// modes) by block Arnoldi on the step's tangent over one period, for models too large to
+    /// carry every direction (a damping integrator; a state of fewer than 3 (K + 4) entries
+    /// gets the whole analysis).
+    #[arg(long, value_name = "K", conflicts_with = "monodromy",
+          value_parser = clap::builder::RangedU64ValueParser::<usize>::new().range(1..))]
+    modes: Option<usize>,
     /// Prony: the channels to fit (comma-separated; default: every output channel).
     #[arg(long, value_name = "LIST")]
     signals: Option<String>,
@@ -177,9 +188,10 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         values: swept.values,
         methods,
         period: a.period,
-        monodromy: match a.monodromy {
-            MonodromyArg::Tangent => Monodromy::Tangent,
-            MonodromyArg::Runs => Monodromy::Runs,
+        monodromy: match (a.modes, a.monodromy) {
+            (Some(k), _) => Monodromy::Krylov(k),
+            (None, MonodromyArg::Tangent) => Monodromy::Tangent,
+            (None, MonodromyArg::Runs) => Monodromy::Runs,
         },
         signals,
         window,

@@ -28,10 +28,12 @@ pub fn resolve(
     let lu = z0.clone().lu();
     let omega = 2.0 * std::f64::consts::PI / period;
     let top = MAX_HARMONIC.min(history.len() as i32 / 2 - 1).max(0);
-    let (n, harmonics) = (z0.nrows(), (2 * top + 1) as usize);
+    // The measure's components (the directions' count, `z0`'s, may be fewer).
+    let n = history.first().map_or(z0.nrows(), |(_, z)| z.nrows());
+    let (r, harmonics) = (z0.nrows(), (2 * top + 1) as usize);
     // Every mode's start at once: `W = Z_0^-1 V`, real and imaginary parts.
     let part = |pick: fn(&(f64, f64)) -> f64| {
-        DMatrix::from_fn(n, modes.len(), |i, m| modes[m].1.get(i).map_or(0.0, pick))
+        DMatrix::from_fn(r, modes.len(), |i, m| modes[m].1.get(i).map_or(0.0, pick))
     };
     let (wr, wi) = (lu.solve(&part(|x| x.0))?, lu.solve(&part(|x| x.1))?);
     // c_l = sum_k exp(-s t_k) y(t_k) exp(-i l Omega t_k), per mode, harmonic and component.

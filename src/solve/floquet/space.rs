@@ -198,24 +198,35 @@ impl Space {
     /// position of direction `dir < rv`, else the velocity of `dir - rv`), the directions
     /// without inertia displaced to stay in equilibrium.
     pub(super) fn perturbed(&self, sys: &System, dir: usize, eps: f64) -> State {
+        let mut x = vec![0.0; self.dim()];
+        x[dir] = 1.0;
+        self.perturbed_along(sys, &x, eps)
+    }
+
+    /// The model's initial state perturbed by `eps` along the state `x` (`dim` entries: the
+    /// positions of the directions with inertia, then their velocities), the directions
+    /// without inertia displaced to stay in equilibrium.
+    pub(super) fn perturbed_along(&self, sys: &System, x: &[f64], eps: f64) -> State {
         let nfree = self.free.len();
-        let (c, velocity) = (dir % self.rv, dir >= self.rv);
-        let col = &self.velocities[c * nfree..(c + 1) * nfree];
-        let follow = &self.slaved[dir * nfree..(dir + 1) * nfree];
         let mut st = sys.initial.clone();
         let mut turns = vec![V3::zeros(); sys.rotations.len()];
-        let moves = col.iter().map(|&x| (x, velocity)).enumerate();
-        let follows = follow.iter().map(|&x| (x, false)).enumerate();
-        for (j, (x, velocity)) in moves.chain(follows) {
-            let i = self.free[j];
-            let d = eps * self.weights[j] * x;
-            match (sys.unknowns[i], velocity) {
-                (UnknownKind::Rotation { node, axis }, false) => turns[node][axis] += d,
-                (UnknownKind::Rotation { node, axis }, true) => {
-                    st.rot[node].w[axis] += d * self.omega
+        for (dir, &xd) in x.iter().enumerate().filter(|(_, &xd)| xd != 0.0) {
+            let (c, velocity) = (dir % self.rv, dir >= self.rv);
+            let col = &self.velocities[c * nfree..(c + 1) * nfree];
+            let follow = &self.slaved[dir * nfree..(dir + 1) * nfree];
+            let moves = col.iter().map(|&x| (x, velocity)).enumerate();
+            let follows = follow.iter().map(|&x| (x, false)).enumerate();
+            for (j, (x, velocity)) in moves.chain(follows) {
+                let i = self.free[j];
+                let d = eps * xd * self.weights[j] * x;
+                match (sys.unknowns[i], velocity) {
+                    (UnknownKind::Rotation { node, axis }, false) => turns[node][axis] += d,
+                    (UnknownKind::Rotation { node, axis }, true) => {
+                        st.rot[node].w[axis] += d * self.omega
+                    }
+                    (_, false) => st.q[i] += d,
+                    (_, true) => st.v[i] += d * self.omega,
                 }
-                (_, false) => st.q[i] += d,
-                (_, true) => st.v[i] += d * self.omega,
             }
         }
         for (k, th) in turns.iter().enumerate() {

@@ -60,6 +60,18 @@ impl Integrator<'_> {
     }
 }
 
+impl Integrator<'_> {
+    /// The weight of each slot of a carried direction (positions over their scale, rates
+    /// times the motion's time scale, accelerations times `h^2`): the weighted state in which
+    /// deflation and the settled directions are orthonormal; `None` before
+    /// [`Integrator::track`].
+    pub fn direction_weights(&self) -> Option<Vec<f64>> {
+        let tk = self.tracked.as_ref()?;
+        let n = self.sys.len();
+        Some((0..4 * n).map(|i| weight(tk, n, self.set.dt, i)).collect())
+    }
+}
+
 /// The weight of slot `i` of a direction (`n` unknowns, steps of `h`): positions over their
 /// scale, rates times the motion's time scale, accelerations times `h^2`.
 fn weight(tk: &Tracked, n: usize, h: f64, i: usize) -> f64 {

@@ -258,6 +258,13 @@ impl<'s> Integrator<'s> {
         &self.set
     }
 
+    /// Makes the next [`Integrator::run`] take `steps` steps of the run's size from the
+    /// current state (partial Floquet runs a period in parts).
+    pub fn set_run(&mut self, steps: usize) {
+        self.set.steps = steps;
+        self.set.until = self.cur.t + steps as f64 * self.set.dt;
+    }
+
     /// Lengthens the run by `extra` steps of its size.
     pub fn extend_run(&mut self, extra: usize) {
         self.set.steps += extra;

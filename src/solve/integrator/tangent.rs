@@ -484,6 +484,12 @@ impl Integrator<'_> {
         let factored = self.refactor(h, aug, false);
         self.exact_rates = false;
         factored?;
+        tk.h = h;
+        if tk.count == 0 {
+            // Nothing carried (partial Floquet's way to a period's phase): the matrix is
+            // still factored at the converged step, as the next step's Newton expects.
+            return Ok(());
+        }
         self.node_maps(&mut tk.nodes);
         let coef = self.coefficients(h);
         tk.gradients.iter_mut().for_each(|x| *x = 0.0);

@@ -210,11 +210,16 @@ fn summary(spec: &SweepSpec, point: &Point) -> String {
     match &point.failure {
         Some(f) => format!("{} = {value} ({}): failed: {f}", spec.param, method.name()),
         None => format!(
-            "{} = {value} ({}): largest Re s {:.4e} 1/s, {:.2} s CPU",
+            "{} = {value} ({}): largest Re s {:.4e} 1/s, {:.2} s CPU{}",
             spec.param,
             method.name(),
             point.max_real(),
-            point.cpu_s
+            point.cpu_s,
+            // Partial Floquet says what it did.
+            point
+                .detail
+                .split_once("; partial: ")
+                .map_or(String::new(), |(_, p)| format!(" (partial: {p})"))
         ),
     }
 }
@@ -287,8 +292,22 @@ fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Result<Found, PointError> {
         modes: modes_of(&resolved),
         rotor_speed: std::f64::consts::TAU / period,
         detail: format!(
-            "{} free coordinates, {} steps of {:.4e} s per period {:.6} s",
-            f.free, f.steps, f.dt, f.period
+            "{} free coordinates, {} steps of {:.4e} s per period {:.6} s{}",
+            f.free,
+            f.steps,
+            f.dt,
+            f.period,
+            f.partial.as_ref().map_or(String::new(), |p| format!(
+                "; partial: {} multipliers wanted, {} runs of a period carrying {} directions{}",
+                p.wanted,
+                p.products,
+                p.block,
+                if p.converged {
+                    ""
+                } else {
+                    " (not converged before the basis spanned the state)"
+                }
+            ))
         ),
     })
 }
