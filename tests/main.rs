@@ -33,3 +33,4 @@ mod spectral;
 mod study;
 mod timoshenko;
 mod towers;
+mod twisted;

@@ -213,7 +213,7 @@ fn center_of_mass_weighs_bodies_beams_and_concentrated_masses() {
         Ok(c) => c,
         Err(f) => panic!("{:?}", f.diagnostics),
     };
-    let frame = compiled.model.beams[0].frame;
+    let frame = compiled.model.beams[0].frames[0];
     let axis2 = [frame[0][1], frame[1][1], frame[2][1]];
     let trace = match simulate_text("cm.mbd", text, Request::default()) {
         Ok(t) => t,

@@ -46,7 +46,7 @@ pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initia
             dofs,
             local.iter().map(|&k| ids[k]).collect(),
             &positions,
-            vec![b.frame; p],
+            local.iter().map(|&k| b.frames[k]).collect(),
             b.section.stiffness,
             m,
             eta,

@@ -427,7 +427,7 @@ fn probe(
                 }
                 Attach::BeamNode { beam, node } => {
                     let b = &lw.model.beams[beam];
-                    let o = m3(&b.frame);
+                    let o = m3(&b.frames[node]);
                     (V3::from(b.initial_nodes[node]) + o * V3::from(offset), o)
                 }
                 _ => (V3::from(offset), M3::identity()),

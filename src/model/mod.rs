@@ -147,8 +147,9 @@ pub struct Beam {
     pub nodes: Vec<[f64; 3]>,
     /// Node positions at t = 0 (the reference ones unless `spin_stretch` displaces them).
     pub initial_nodes: Vec<[f64; 3]>,
-    /// Section frame at t = 0 (columns: axes 1, 2, 3), the same at every node.
-    pub frame: Mat3,
+    /// Section frame of each node at t = 0 (columns: axes 1, 2, 3): the beam's frame turned
+    /// about axis 1 by the twist there.
+    pub frames: Vec<Mat3>,
     pub length: f64,
     /// Velocity and angular velocity of each node at t = 0.
     pub velocities: Vec<[f64; 3]>,

@@ -19,7 +19,9 @@ struct Layout {
     section: Section,
     elements: usize,
     order: usize,
-    twist: f64,
+    /// Stations `(arc length, twist)`, linear between, held beyond the ends (one station for a
+    /// constant twist), and where they are written.
+    twist: (Vec<(f64, f64)>, Span),
     e2: Option<[f64; 3]>,
     velocity: [f64; 3],
     angular_velocity: [f64; 3],
@@ -59,10 +61,17 @@ impl Builder<'_> {
         let b = self.beam_layout(v, &p)?;
         let d = sub(b.to, b.from);
         let length = norm(d);
-        let (e1, frame) = self.section_frame(v, &p, d, &b)?;
+        let (e1, base) = self.section_frame(v, &p, d, &b)?;
         let n = b.elements * (b.order - 1) + 1;
+        self.check_twist(v, &b.twist, length, Self::has_flag(v, "rigid"))?;
+        let frames: Vec<Mat3> = (0..n)
+            .map(|k| {
+                let s = length * k as f64 / (n - 1) as f64;
+                mat_mul(base, rotation([1.0, 0.0, 0.0], twist_at(&b.twist.0, s)))
+            })
+            .collect();
         if Self::has_flag(v, "rigid") {
-            return self.rigid_beam(v, &b, length, n, frame);
+            return self.rigid_beam(v, &b, length, n, frames[0]);
         }
         let nodes: Vec<[f64; 3]> = (0..n)
             .map(|k| add(b.from, scale(d, k as f64 / (n - 1) as f64)))
@@ -92,7 +101,7 @@ impl Builder<'_> {
             velocities,
             nodes,
             initial_nodes,
-            frame,
+            frames,
             length,
             point_masses: Vec::new(),
         });
@@ -125,14 +134,8 @@ impl Builder<'_> {
         };
         let (elements, order) = self.discretization(v, p);
         let twist = match self.expr(v.scope, p.get("twist")) {
-            Some(e) => {
-                let x = self.scalar(v.scope, e, units::ANGLE, "`twist`");
-                if x.is_some() {
-                    self.angle_unit(v.scope, Some(e), x, "`twist`");
-                }
-                x
-            }
-            None => Some(0.0),
+            Some(e) => self.twist(v.scope, e).map(|t| (t, e.span)),
+            None => Some((vec![(0.0, 0.0)], v.name_span)),
         };
         let e2 = match self.expr(v.scope, p.get("e2")) {
             Some(e) => self.direction(v.scope, e, "`e2`").map(Some),
@@ -198,8 +201,93 @@ impl Builder<'_> {
         (elements, order)
     }
 
-    /// The beam's axis 1 and its section frame at t = 0 (axis 2 from `e2` or a default
-    /// across the beam, turned by `twist`).
+    /// `twist`: an angle, or stations `((s, angle), ...)` with `s` the arc length from `from`.
+    fn twist(&mut self, scope: usize, e: &crate::syntax::ast::Expr) -> Option<Vec<(f64, f64)>> {
+        use crate::syntax::ast::ExprKind;
+        let rows = match &e.kind {
+            ExprKind::Vector { items, unit: None }
+                if items
+                    .iter()
+                    .all(|r| matches!(&r.kind, ExprKind::Vector { .. })) =>
+            {
+                items
+            }
+            _ => {
+                let x = self.scalar(scope, e, units::ANGLE, "`twist`");
+                if x.is_some() {
+                    self.angle_unit(scope, Some(e), x, "`twist`");
+                }
+                return x.map(|a| vec![(0.0, a)]);
+            }
+        };
+        let mut out = Vec::with_capacity(rows.len());
+        for row in rows {
+            let ExprKind::Vector { items, unit: None } = &row.kind else {
+                continue;
+            };
+            if items.len() != 2 {
+                self.error(
+                    scope,
+                    Diagnostic::error(Code::E0209, "a twist station is an arc length and an angle")
+                        .at(row.span, format!("{} entries", items.len()))
+                        .hint("write `twist = ((0 m, 0 deg), (2.5 m, -8 deg))`: each station `(s, angle)`, s from the beam's `from`, each entry with its unit"),
+                );
+                return None;
+            }
+            let s = self.scalar(
+                scope,
+                &items[0],
+                Dim::LENGTH,
+                "a twist station's arc length",
+            );
+            let a = self.scalar(scope, &items[1], units::ANGLE, "a twist station's angle");
+            if a.is_some() {
+                self.angle_unit(scope, Some(&items[1]), a, "a twist station's angle");
+            }
+            out.push((s?, a?));
+        }
+        Some(out)
+    }
+
+    /// Twist stations within the beam (`0 <= s <= length`), in increasing arc length; a
+    /// rigid beam takes one angle.
+    fn check_twist(
+        &mut self,
+        v: &View,
+        (stations, span): &(Vec<(f64, f64)>, Span),
+        length: f64,
+        rigid: bool,
+    ) -> Option<()> {
+        let inside = stations
+            .iter()
+            .all(|&(s, _)| (-1e-12 * length..=length * (1.0 + 1e-12)).contains(&s));
+        let increasing = stations.windows(2).all(|w| w[1].0 > w[0].0);
+        let varies = stations.iter().any(|&(_, a)| a != stations[0].1);
+        let problem = if stations.is_empty() {
+            Some("no station")
+        } else if !inside {
+            Some("a station outside the beam")
+        } else if !increasing {
+            Some("stations not in increasing arc length")
+        } else if rigid && varies {
+            Some("a varying twist on a rigid beam")
+        } else {
+            None
+        };
+        let Some(problem) = problem else {
+            return Some(());
+        };
+        self.error(
+            v.scope,
+            Diagnostic::error(Code::E0213, format!("the twist of beam `{}` has {problem}", v.name))
+                .at(*span, problem)
+                .hint(format!("give stations `(s, angle)` with s increasing from 0 to the beam's length ({length} m); a `rigid` beam takes one angle")),
+        );
+        None
+    }
+
+    /// The beam's axis 1 and its section frame at t = 0 before the twist (axis 2 from `e2` or
+    /// a default across the beam).
     fn section_frame(
         &mut self,
         v: &View,
@@ -246,7 +334,7 @@ impl Builder<'_> {
             [e1[1], e2[1], e3[1]],
             [e1[2], e2[2], e3[2]],
         ];
-        Some((e1, mat_mul(base, rotation([1.0, 0.0, 0.0], b.twist))))
+        Some((e1, base))
     }
 
     /// The nodes at t = 0: with `spin_stretch`, the steady centrifugal stretch of a beam
@@ -348,5 +436,18 @@ impl Builder<'_> {
                 beam_axis: Some((length, nodes)),
             },
         )
+    }
+}
+
+/// The twist at arc length `s`: linear between the stations, held beyond the ends.
+pub(super) fn twist_at(stations: &[(f64, f64)], s: f64) -> f64 {
+    match stations {
+        [] => 0.0,
+        [(s0, a0), ..] if s <= *s0 => *a0,
+        [.., (sl, al)] if s >= *sl => *al,
+        _ => stations.windows(2).find(|w| s <= w[1].0).map_or(0.0, |w| {
+            let f = (s - w[0].0) / (w[1].0 - w[0].0);
+            w[0].1 + f * (w[1].1 - w[0].1)
+        }),
     }
 }

@@ -202,12 +202,24 @@ impl Builder<'_> {
             scale(beam.initial_nodes[k], 1.0 - w),
             scale(beam.initial_nodes[k + 1], w),
         );
+        // The section frame there: node k's, turned by the share `w` of the twist to the next.
+        let frame = match w {
+            _ if beam.frames[k] == beam.frames[k + 1] => beam.frames[k],
+            0.0 => beam.frames[k],
+            1.0 => beam.frames[k + 1],
+            _ => {
+                let (a, b) = (beam.frames[k], beam.frames[k + 1]);
+                let r = |i: usize, j: usize| (0..3).map(|l| a[l][i] * b[l][j]).sum::<f64>();
+                let turn = r(2, 1).atan2(r(1, 1));
+                mat_mul(a, crate::model::eval::rotation([1.0, 0.0, 0.0], w * turn))
+            }
+        };
         Some(Marker {
             attach,
             offset: o,
             axes: IDENTITY,
-            position: add(at, mat_vec(beam.frame, o)),
-            world_axes: beam.frame,
+            position: add(at, mat_vec(frame, o)),
+            world_axes: frame,
             text: format!(
                 "{text}.{}",
                 rest.first()
