@@ -25,7 +25,7 @@ const CASES: &[(&str, &[Code])] = &[
     ("unknown_output", &[Code::E0212]),
     ("alpha_out_of_range", &[Code::E0213]),
     ("unknown_newton_mode", &[Code::E0211]),
-    ("twist_stations", &[Code::E0213, Code::E0209]),
+    ("twist_stations", &[Code::E0213, Code::E0209, Code::E0213]),
     ("joint_to_itself", &[Code::E0301]),
     ("negative_mass", &[Code::E0302]),
     ("zero_length", &[Code::E0303]),

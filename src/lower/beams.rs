@@ -2,21 +2,53 @@
 //! and the nodes' initial state.
 
 use super::Lower;
-use crate::model::Beam;
+use crate::model::{Beam, Section};
+use crate::runtime::beams::SectionAt;
 use crate::runtime::rotation::{M3, V3};
 use crate::runtime::{
     arr3, m3, BeamElement, Element, NodeRotation, Probe, ProbeQuantity, RigidBody, State,
 };
 
-/// Section mass properties in the section frame: `m`, `eta*` and the inertia per length about
-/// the reference line (the section gives it about its centre of mass).
-pub fn section_mass(b: &Beam) -> (f64, [f64; 3], [[f64; 3]; 3]) {
-    let s = &b.section;
+/// A section's properties for the element, in the section frame: its stiffness, `m`, `eta*`
+/// and the inertia per length about the reference line (the section gives it about its centre
+/// of mass).
+fn properties(s: &Section) -> SectionAt {
     let m = s.mass_per_length;
     let eta = V3::new(0.0, s.mass_offset[0], s.mass_offset[1]);
     let rc = M3::from_diagonal(&V3::new(s.inertia[0], s.inertia[1], s.inertia[2]));
     let rho = rc + (M3::identity() * eta.norm_squared() - eta * eta.transpose()) * m;
-    (m, eta.into(), arr3(&rho))
+    SectionAt {
+        stiffness: s.stiffness,
+        mass: m,
+        eta: eta.into(),
+        rho: arr3(&rho),
+    }
+}
+
+/// The section at arc length `s` of beam `b`: its own, or between its stations the linear
+/// interpolation of theirs (stiffness, mass per length, offsets and inertias), held beyond
+/// the first and the last.
+pub fn section_at(b: &Beam, s: f64) -> SectionAt {
+    let stations = &b.sections;
+    let Some(i) = stations.windows(2).position(|w| s < w[1].0) else {
+        return properties(stations.last().map_or(&b.section, |(_, x)| x));
+    };
+    let ((s0, a), (s1, c)) = (&stations[i], &stations[i + 1]);
+    if s <= *s0 {
+        return properties(a);
+    }
+    let f = (s - s0) / (s1 - s0);
+    let mix = |x: f64, y: f64| x + f * (y - x);
+    let section = Section {
+        name: a.name.clone(),
+        stiffness: std::array::from_fn(|r| {
+            std::array::from_fn(|k| mix(a.stiffness[r][k], c.stiffness[r][k]))
+        }),
+        mass_per_length: mix(a.mass_per_length, c.mass_per_length),
+        mass_offset: std::array::from_fn(|k| mix(a.mass_offset[k], c.mass_offset[k])),
+        inertia: std::array::from_fn(|k| mix(a.inertia[k], c.inertia[k])),
+    };
+    properties(&section)
 }
 
 pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initial: &mut State) {
@@ -33,8 +65,8 @@ pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initia
             ..NodeRotation::REST
         };
     }
-    let (m, eta, rho) = section_mass(b);
     let p = b.order;
+    let le = b.length / b.elements as f64;
     for e in 0..b.elements {
         let local: Vec<usize> = (e * (p - 1)..=e * (p - 1) + p - 1).collect();
         let dofs = local
@@ -47,10 +79,7 @@ pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initia
             local.iter().map(|&k| ids[k]).collect(),
             &positions,
             local.iter().map(|&k| b.frames[k]).collect(),
-            b.section.stiffness,
-            m,
-            eta,
-            rho,
+            &|xi: f64| section_at(b, le * (e as f64 + (xi + 1.0) / 2.0)),
             model.gravity,
         )));
     }

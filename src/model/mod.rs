@@ -139,7 +139,11 @@ pub struct Section {
 pub struct Beam {
     pub name: String,
     pub span: Span,
+    /// The section (the first station's where the section varies).
     pub section: Section,
+    /// Stations `(arc length, section)` of a section varying along the span, linear between
+    /// them (empty: `section` everywhere).
+    pub sections: Vec<(f64, Section)>,
     pub elements: usize,
     /// Nodes per element: 2, 3 or 4.
     pub order: usize,

@@ -27,13 +27,25 @@ use serde::{Deserialize, Serialize};
 const MAXN: usize = 4;
 
 /// One quadrature point: weight times Jacobian, shape functions and their arc-length
-/// derivatives, and the reference strains `(gamma*_0, kappa*_0)` there.
+/// derivatives, the reference strains `(gamma*_0, kappa*_0)` and the section there.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Gauss {
     pub wj: f64,
     pub n: [f64; MAXN],
     pub dn: [f64; MAXN],
     pub strain0: [f64; 6],
+    pub section: SectionAt,
+}
+
+/// A section's properties at a point, in the section frame: the stiffness (forces, then
+/// moments), the mass per length, the centre-of-mass offset and the inertia per length about
+/// the reference line.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SectionAt {
+    pub stiffness: [[f64; 6]; 6],
+    pub mass: f64,
+    pub eta: [f64; 3],
+    pub rho: [[f64; 3]; 3],
 }
 
 /// A beam element.
@@ -45,13 +57,6 @@ pub struct BeamElement {
     pub nodes: Vec<usize>,
     /// Section triad of each node at t = 0 (columns: axes 1, 2, 3).
     pub triads: Vec<[[f64; 3]; 3]>,
-    /// Sectional stiffness in the section frame (forces, then moments).
-    pub stiffness: [[f64; 6]; 6],
-    /// Mass per length, centre-of-mass offset and inertia per length about the reference
-    /// line, in the section frame.
-    pub mass: f64,
-    pub eta: [f64; 3],
-    pub rho: [[f64; 3]; 3],
     pub gravity: [f64; 3],
     /// Distributed force per length (inertial), fixed.
     pub load: [f64; 3],
@@ -153,10 +158,7 @@ impl BeamElement {
         nodes: Vec<usize>,
         positions: &[[f64; 3]],
         triads: Vec<[[f64; 3]; 3]>,
-        stiffness: [[f64; 6]; 6],
-        mass: f64,
-        eta: [f64; 3],
-        rho: [[f64; 3]; 3],
+        section: &dyn Fn(f64) -> SectionAt,
         gravity: [f64; 3],
     ) -> BeamElement {
         let nn = nodes.len();
@@ -176,6 +178,7 @@ impl BeamElement {
                         n,
                         dn: dn.map(|x| x / j),
                         strain0: [0.0; 6],
+                        section: section(xi),
                     }
                 })
                 .collect()
@@ -184,10 +187,6 @@ impl BeamElement {
             dofs,
             nodes,
             triads,
-            stiffness,
-            mass,
-            eta,
-            rho,
             gravity,
             load: [0.0; 3],
             elastic: points(nn - 1),
@@ -311,7 +310,7 @@ impl BeamElement {
         ];
         let mut n = [0.0; 6];
         for (i, ni) in n.iter_mut().enumerate() {
-            *ni = (0..6).map(|j| self.stiffness[i][j] * e[j]).sum();
+            *ni = (0..6).map(|j| gp.section.stiffness[i][j] * e[j]).sum();
         }
         (
             f.t * V3::new(n[0], n[1], n[2]),
@@ -321,11 +320,9 @@ impl BeamElement {
     }
 
     /// Sectional mass quantities at a point: `m eta` and `rho` (inertial).
-    fn inertia(&self, t: &M3) -> (V3, M3) {
-        (
-            t * V3::from(self.eta) * self.mass,
-            t * m3(&self.rho) * t.transpose(),
-        )
+    fn inertia(t: &M3, gp: &Gauss) -> (V3, M3) {
+        let s = &gp.section;
+        (t * V3::from(s.eta) * s.mass, t * m3(&s.rho) * t.transpose())
     }
 
     pub fn residual(&self, st: &State, r: &mut Residual) {
@@ -350,12 +347,13 @@ impl BeamElement {
         let load = V3::from(self.load);
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, false);
-            let (meta, rho) = self.inertia(&f.t);
+            let (meta, rho) = Self::inertia(&f.t, gp);
             let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
             let (wt, dwt) = (tilde(&w), tilde(&dw));
-            let fu = self.mass * a + (dwt + wt * wt) * meta;
+            let mass = gp.section.mass;
+            let fu = mass * a + (dwt + wt * wt) * meta;
             let ft = meta.cross(&a) + rho * dw + w.cross(&(rho * w));
-            let ext_u = self.mass * g + load;
+            let ext_u = mass * g + load;
             let ext_t = meta.cross(&g);
             for k in 0..nn {
                 let d = &self.dofs[6 * k..6 * k + 6];
@@ -384,7 +382,7 @@ impl BeamElement {
             let f = self.field(&rel, &x, gp, true);
             let (fo, mo, _) = self.resultants(&f, gp);
             // Inertial 6x6 stiffness, split in blocks.
-            let cs = m6_blocks(&self.stiffness);
+            let cs = m6_blocks(&gp.section.stiffness);
             let c11 = f.t * cs[0] * f.t.transpose();
             let c12 = f.t * cs[1] * f.t.transpose();
             let c21 = f.t * cs[2] * f.t.transpose();
@@ -420,12 +418,12 @@ impl BeamElement {
         let g = V3::from(self.gravity);
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, true);
-            let (meta, rho) = self.inertia(&f.t);
+            let (meta, rho) = Self::inertia(&f.t, gp);
             let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
             let (wt, dwt, at) = (tilde(&w), tilde(&dw), tilde(&a));
             let et = tilde(&meta);
             let (rw, rdw) = (rho * w, rho * dw);
-            let m_uu = M3::identity() * self.mass;
+            let m_uu = M3::identity() * gp.section.mass;
             let g_ut = tilde(&(wt * meta)).transpose() + wt * et.transpose();
             let g_tt = wt * rho - tilde(&rw);
             let k_ut = (dwt + wt * wt) * et.transpose();
@@ -462,13 +460,13 @@ impl BeamElement {
         let (wn, _) = self.rates(st);
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, false);
-            let (meta, rho) = self.inertia(&f.t);
+            let (meta, rho) = Self::inertia(&f.t, gp);
             let (mut v, mut w) = (V3::zeros(), V3::zeros());
             for k in 0..nn {
                 v += vn[k] * gp.n[k];
                 w += wn[k] * gp.n[k];
             }
-            let h = self.mass * v + w.cross(&meta);
+            let h = gp.section.mass * v + w.cross(&meta);
             let g = rho * w + meta.cross(&v);
             let gt = v.cross(&h);
             for k in 0..nn {
@@ -496,7 +494,7 @@ impl BeamElement {
             let mut u = 0.0;
             for i in 0..6 {
                 for j in 0..6 {
-                    u += s[i] * self.stiffness[i][j] * s[j];
+                    u += s[i] * gp.section.stiffness[i][j] * s[j];
                 }
             }
             e.potential += 0.5 * gp.wj * u;
@@ -505,7 +503,7 @@ impl BeamElement {
         let g = V3::from(self.gravity);
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, false);
-            let (meta, rho) = self.inertia(&f.t);
+            let (meta, rho) = Self::inertia(&f.t, gp);
             let (mut v, mut w, mut xp) = (V3::zeros(), V3::zeros(), V3::zeros());
             for k in 0..nn {
                 let d = &self.dofs[6 * k..6 * k + 3];
@@ -513,11 +511,12 @@ impl BeamElement {
                 w += wn[k] * gp.n[k];
                 xp += x[k] * gp.n[k];
             }
+            let mass = gp.section.mass;
             e.kinetic += gp.wj
-                * (0.5 * self.mass * v.norm_squared()
+                * (0.5 * mass * v.norm_squared()
                     + v.dot(&w.cross(&meta))
                     + 0.5 * w.dot(&(rho * w)));
-            e.potential -= gp.wj * g.dot(&(self.mass * xp + meta));
+            e.potential -= gp.wj * g.dot(&(mass * xp + meta));
         }
         e
     }
@@ -534,7 +533,7 @@ impl BeamElement {
         let mut out = MassMoments::default();
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, false);
-            let (meta, _) = self.inertia(&f.t);
+            let (meta, _) = Self::inertia(&f.t, gp);
             let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
             let (mut xp, mut v) = (V3::zeros(), V3::zeros());
             for k in 0..nn {
@@ -542,11 +541,12 @@ impl BeamElement {
                 xp += x[k] * gp.n[k];
                 v += V3::new(st.v[d[0]], st.v[d[1]], st.v[d[2]]) * gp.n[k];
             }
+            let mass = gp.section.mass;
             out += MassMoments {
-                mass: gp.wj * self.mass,
-                position: (xp * self.mass + meta) * gp.wj,
-                velocity: (v * self.mass + w.cross(&meta)) * gp.wj,
-                acceleration: (a * self.mass + dw.cross(&meta) + w.cross(&w.cross(&meta))) * gp.wj,
+                mass: gp.wj * mass,
+                position: (xp * mass + meta) * gp.wj,
+                velocity: (v * mass + w.cross(&meta)) * gp.wj,
+                acceleration: (a * mass + dw.cross(&meta) + w.cross(&w.cross(&meta))) * gp.wj,
             };
         }
         out
@@ -554,14 +554,41 @@ impl BeamElement {
 
     /// Mass of the element.
     pub fn total_mass(&self) -> f64 {
-        self.mass * self.inertial.iter().map(|g| g.wj).sum::<f64>()
+        match self.uniform() {
+            Some(u) => u.mass * self.inertial.iter().map(|g| g.wj).sum::<f64>(),
+            None => self
+                .inertial
+                .iter()
+                .map(|g| g.section.mass * g.wj)
+                .sum::<f64>(),
+        }
     }
 
     /// A typical diagonal stiffness: the mean sectional stiffness over the element length.
     pub fn stiffness_scale(&self) -> f64 {
         let l: f64 = self.inertial.iter().map(|g| g.wj).sum();
-        let d: f64 = (0..3).map(|i| self.stiffness[i][i]).sum::<f64>() / 3.0;
+        let diagonal = |s: &SectionAt| (0..3).map(|i| s.stiffness[i][i]).sum::<f64>() / 3.0;
+        let d: f64 = match self.uniform() {
+            Some(u) => diagonal(u),
+            None => {
+                self.elastic
+                    .iter()
+                    .map(|g| g.wj * diagonal(&g.section))
+                    .sum::<f64>()
+                    / self.elastic.iter().map(|g| g.wj).sum::<f64>()
+            }
+        };
         d / l * (self.len() - 1) as f64
+    }
+
+    /// The section of every quadrature point, if they share one.
+    fn uniform(&self) -> Option<&SectionAt> {
+        let first = &self.inertial.first()?.section;
+        self.inertial
+            .iter()
+            .chain(&self.elastic)
+            .all(|g| g.section == *first)
+            .then_some(first)
     }
 }
 

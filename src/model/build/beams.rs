@@ -17,6 +17,9 @@ struct Layout {
     from: [f64; 3],
     to: [f64; 3],
     section: Section,
+    /// Stations `(arc length, section)` of a varying section (empty: `section` everywhere),
+    /// and where they are written.
+    sections: (Vec<(f64, Section)>, Span),
     elements: usize,
     order: usize,
     /// Stations `(arc length, twist)`, linear between, held beyond the ends (one station for a
@@ -63,7 +66,20 @@ impl Builder<'_> {
         let length = norm(d);
         let (e1, base) = self.section_frame(v, &p, d, &b)?;
         let n = b.elements * (b.order - 1) + 1;
-        self.check_twist(v, &b.twist, length, Self::has_flag(v, "rigid"))?;
+        let rigid = Self::has_flag(v, "rigid");
+        let varies = b.twist.0.iter().any(|&(_, a)| a != b.twist.0[0].1);
+        let at: Vec<f64> = b.twist.0.iter().map(|&(s, _)| s).collect();
+        let refuse = (rigid && varies).then_some("a varying twist on a rigid beam");
+        self.check_stations(v, "twist", (&at, b.twist.1), length, refuse)?;
+        if !b.sections.0.is_empty() {
+            let at: Vec<f64> = b.sections.0.iter().map(|&(s, _)| s).collect();
+            let refuse = if rigid {
+                Some("a varying section on a rigid beam")
+            } else {
+                b.spin.map(|_| "a varying section with `spin_stretch`")
+            };
+            self.check_stations(v, "section", (&at, b.sections.1), length, refuse)?;
+        }
         let frames: Vec<Mat3> = (0..n)
             .map(|k| {
                 let s = length * k as f64 / (n - 1) as f64;
@@ -95,6 +111,7 @@ impl Builder<'_> {
             name: v.name.clone(),
             span: v.span,
             section: b.section,
+            sections: b.sections.0,
             elements: b.elements,
             order: b.order,
             angular_velocities: vec![b.angular_velocity; n],
@@ -118,8 +135,13 @@ impl Builder<'_> {
         };
         let from = get(self, "from");
         let to = get(self, "to");
+        let mut sections = (Vec::new(), v.name_span);
         let section = match p.get("section").map(|s| s.value.clone()) {
             Some(PropValue::Block(b)) => self.section(v, &b, format!("{}.section", v.name)),
+            Some(PropValue::Expr(e)) if stations(&e).is_some() => {
+                sections = (self.section_stations(v, &e)?, e.span);
+                sections.0.first().map(|(_, x)| x.clone())
+            }
             Some(PropValue::Expr(e)) => self.section_ref(v, &e),
             None => {
                 self.missing(
@@ -152,6 +174,7 @@ impl Builder<'_> {
             from: from?,
             to: to?,
             section: section?,
+            sections,
             elements: elements?,
             order: order?,
             twist: twist?,
@@ -249,39 +272,66 @@ impl Builder<'_> {
         Some(out)
     }
 
-    /// Twist stations within the beam (`0 <= s <= length`), in increasing arc length; a
-    /// rigid beam takes one angle.
-    fn check_twist(
+    /// `section = ((s, NAME), ...)`: sections at stations, each a declared section.
+    fn section_stations(
         &mut self,
         v: &View,
-        (stations, span): &(Vec<(f64, f64)>, Span),
+        e: &crate::syntax::ast::Expr,
+    ) -> Option<Vec<(f64, Section)>> {
+        let mut out = Vec::new();
+        for items in stations(e)? {
+            if items.len() != 2 {
+                self.error(
+                    v.scope,
+                    Diagnostic::error(Code::E0209, "a section station is an arc length and a section")
+                        .at(e.span, format!("a station with {} entries", items.len()))
+                        .hint("write `section = ((0 m, root), (2.5 m, tip))`: each station `(s, NAME)`, s from the beam's `from`, NAME a declared section"),
+                );
+                return None;
+            }
+            let s = self.scalar(
+                v.scope,
+                &items[0],
+                Dim::LENGTH,
+                "a section station's arc length",
+            );
+            let section = self.section_ref(v, &items[1]);
+            out.push((s?, section?));
+        }
+        Some(out)
+    }
+
+    /// Stations (of the twist or the section, `what`) within the beam (`0 <= s <= length`), in
+    /// increasing arc length; `refuse` says why the beam takes none.
+    fn check_stations(
+        &mut self,
+        v: &View,
+        what: &str,
+        (at, span): (&[f64], Span),
         length: f64,
-        rigid: bool,
+        refuse: Option<&str>,
     ) -> Option<()> {
-        let inside = stations
+        let inside = at
             .iter()
-            .all(|&(s, _)| (-1e-12 * length..=length * (1.0 + 1e-12)).contains(&s));
-        let increasing = stations.windows(2).all(|w| w[1].0 > w[0].0);
-        let varies = stations.iter().any(|&(_, a)| a != stations[0].1);
-        let problem = if stations.is_empty() {
+            .all(|&s| (-1e-12 * length..=length * (1.0 + 1e-12)).contains(&s));
+        let increasing = at.windows(2).all(|w| w[1] > w[0]);
+        let problem = if at.is_empty() {
             Some("no station")
         } else if !inside {
             Some("a station outside the beam")
         } else if !increasing {
             Some("stations not in increasing arc length")
-        } else if rigid && varies {
-            Some("a varying twist on a rigid beam")
         } else {
-            None
+            refuse
         };
         let Some(problem) = problem else {
             return Some(());
         };
         self.error(
             v.scope,
-            Diagnostic::error(Code::E0213, format!("the twist of beam `{}` has {problem}", v.name))
-                .at(*span, problem)
-                .hint(format!("give stations `(s, angle)` with s increasing from 0 to the beam's length ({length} m); a `rigid` beam takes one angle")),
+            Diagnostic::error(Code::E0213, format!("the {what} of beam `{}` has {problem}", v.name))
+                .at(span, problem)
+                .hint(format!("give stations `(s, {what})` with s increasing from 0 to the beam's length ({length} m); a `rigid` beam takes one {what}, and `spin_stretch` one section")),
         );
         None
     }
@@ -450,4 +500,20 @@ pub(super) fn twist_at(stations: &[(f64, f64)], s: f64) -> f64 {
             w[0].1 + f * (w[1].1 - w[0].1)
         }),
     }
+}
+
+/// The rows of a table of stations, `((a, b), (c, d), ...)`: a vector of vectors (no unit
+/// after the outer parenthesis, none after the rows); `None` if `e` is not one.
+fn stations(e: &crate::syntax::ast::Expr) -> Option<Vec<Vec<crate::syntax::ast::Expr>>> {
+    use crate::syntax::ast::ExprKind;
+    let ExprKind::Vector { items, unit: None } = &e.kind else {
+        return None;
+    };
+    items
+        .iter()
+        .map(|r| match &r.kind {
+            ExprKind::Vector { items, unit: None } => Some(items.clone()),
+            _ => None,
+        })
+        .collect()
 }

@@ -313,15 +313,21 @@ fn beam_case(rng: &mut Lcg, nn: usize) -> (BeamElement, State) {
         crate::runtime::arr3(&(r * d * r.transpose()))
     };
     let dofs: Vec<usize> = (0..6 * nn).collect();
+    // A section varying along the element (a tapered beam), so that the tangent is checked
+    // with different properties at every quadrature point.
+    let eta = [0.0, 0.1 * rng.next(), 0.1 * rng.next()];
+    let section = |xi: f64| crate::runtime::beams::SectionAt {
+        stiffness: stiffness.map(|row| row.map(|k| k * (1.0 + 0.3 * xi))),
+        mass: 1.3 * (1.0 - 0.2 * xi),
+        eta: eta.map(|e| e * (1.0 + 0.5 * xi)),
+        rho: rho.map(|row| row.map(|r| r * (1.0 + 0.4 * xi))),
+    };
     let mut beam = BeamElement::new(
         dofs,
         (0..nn).collect(),
         &positions,
         triads,
-        stiffness,
-        1.3,
-        [0.0, 0.1 * rng.next(), 0.1 * rng.next()],
-        rho,
+        &section,
         rng.v3(),
     );
     beam.load = rng.v3();
