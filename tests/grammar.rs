@@ -380,8 +380,8 @@ fn conditions_and_parts() {
     );
     check(
         Rule::flag,
-        &["rigid", "follower"],
-        &["rigidly", "fixed", ""],
+        &["rigid", "follower", "polyline"],
+        &["rigidly", "fixed", "polylines", ""],
     );
     check(
         Rule::connection,

@@ -2,9 +2,11 @@
 //! stretch and initial motion; `beam NAME rigid` becomes one rigid body. Contract: builds
 //! `Beam`s (sections come from `sections.rs`); must not know beam elements or the runtime.
 
+use super::curve::Curve;
+use super::stations::{stations, twist_at};
 use super::{add, cross, dot, norm, scale, sub, Builder, Built, View};
 use crate::diagnostics::{Code, Diagnostic};
-use crate::model::eval::units::{self, Dim};
+use crate::model::eval::units::Dim;
 use crate::model::eval::{mat_mul, rotation};
 use crate::model::*;
 use crate::syntax::ast::{Prop, PropValue};
@@ -12,8 +14,13 @@ use std::collections::HashMap;
 
 type Props = HashMap<&'static str, Prop>;
 
+/// How to write a curved beam's points.
+const EXAMPLE: &str = "write `points = ((0, 0, 0) m, (1, 0, 0) m, (1.5, 0.5, 0) m)`";
+
 /// A beam's properties, evaluated.
 struct Layout {
+    /// The points a curved beam runs through, and where they are written.
+    points: Option<(Vec<[f64; 3]>, Span)>,
     from: [f64; 3],
     to: [f64; 3],
     section: Section,
@@ -39,7 +46,7 @@ impl Builder<'_> {
             0,
             false,
             false,
-            &["rigid"],
+            &["rigid", "polyline"],
             "beam NAME { from = ..., to = ..., section = S, elements = 4 }",
         ) {
             return None;
@@ -58,15 +65,34 @@ impl Builder<'_> {
                 "velocity",
                 "angular_velocity",
                 "spin_stretch",
+                "points",
             ],
             "a beam",
         );
         let b = self.beam_layout(v, &p)?;
         let d = sub(b.to, b.from);
-        let length = norm(d);
-        let (e1, base) = self.section_frame(v, &p, d, &b)?;
         let n = b.elements * (b.order - 1) + 1;
         let rigid = Self::has_flag(v, "rigid");
+        // Each node's position and axis 1: along the curve through `points`, or the straight
+        // line from `from` to `to`.
+        let (length, along) = match &b.points {
+            Some((points, span)) => {
+                let curve = self.curve(v, points, *span, rigid || b.spin.is_some())?;
+                let length = curve.length();
+                let along: Vec<_> = (0..n)
+                    .map(|k| curve.at(length * k as f64 / (n - 1) as f64))
+                    .collect();
+                (length, along)
+            }
+            None => {
+                let e1 = self.axis(v, d)?;
+                let along = (0..n)
+                    .map(|k| (add(b.from, scale(d, k as f64 / (n - 1) as f64)), e1))
+                    .collect();
+                (norm(d), along)
+            }
+        };
+        let e1 = along[0].1;
         let varies = b.twist.0.iter().any(|&(_, a)| a != b.twist.0[0].1);
         let at: Vec<f64> = b.twist.0.iter().map(|&(s, _)| s).collect();
         let refuse = (rigid && varies).then_some("a varying twist on a rigid beam");
@@ -80,18 +106,23 @@ impl Builder<'_> {
             };
             self.check_stations(v, "section", (&at, b.sections.1), length, refuse)?;
         }
-        let frames: Vec<Mat3> = (0..n)
-            .map(|k| {
-                let s = length * k as f64 / (n - 1) as f64;
-                mat_mul(base, rotation([1.0, 0.0, 0.0], twist_at(&b.twist.0, s)))
-            })
-            .collect();
+        let mut frames: Vec<Mat3> = Vec::with_capacity(n);
+        for &(_, e1) in &along {
+            let base = match frames.first() {
+                // A straight beam's axis is the same at every node.
+                Some(&f) if b.points.is_none() => f,
+                _ => self.section_frame(v, &p, e1, &b)?,
+            };
+            frames.push(base);
+        }
+        for (k, f) in frames.iter_mut().enumerate() {
+            let s = length * k as f64 / (n - 1) as f64;
+            *f = mat_mul(*f, rotation([1.0, 0.0, 0.0], twist_at(&b.twist.0, s)));
+        }
         if Self::has_flag(v, "rigid") {
             return self.rigid_beam(v, &b, length, n, frames[0]);
         }
-        let nodes: Vec<[f64; 3]> = (0..n)
-            .map(|k| add(b.from, scale(d, k as f64 / (n - 1) as f64)))
-            .collect();
+        let nodes: Vec<[f64; 3]> = along.iter().map(|&(x, _)| x).collect();
         let initial_nodes = self.spin_stretch(v, &b, &nodes, e1, length)?;
         let velocities = initial_nodes
             .iter()
@@ -133,8 +164,25 @@ impl Builder<'_> {
             this.required(v.scope, p, key, v.name_span, &of, "(0, 0, 0) m")
                 .and_then(|e| this.vector(v.scope, e, Dim::LENGTH, &format!("`{key}`")))
         };
-        let from = get(self, "from");
-        let to = get(self, "to");
+        let points = match self.expr(v.scope, p.get("points")) {
+            Some(e) => self.points(v.scope, e).map(|x| Some((x, e.span))),
+            None => Some(None),
+        };
+        let (from, to) = match &points {
+            Some(Some((x, span))) => {
+                if let Some(q) = p.get("from").or(p.get("to")) {
+                    self.error(
+                        v.scope,
+                        Diagnostic::error(Code::E0224, format!("beam `{}` gives both `points` and `from`/`to`", v.name))
+                            .at(q.name.span, "here")
+                            .at(*span, "and here")
+                            .hint("a curved beam runs through `points`, from the first to the last; a straight one from `from` to `to`"),
+                    );
+                }
+                (x.first().copied(), x.last().copied())
+            }
+            _ => (get(self, "from"), get(self, "to")),
+        };
         let mut sections = (Vec::new(), v.name_span);
         let section = match p.get("section").map(|s| s.value.clone()) {
             Some(PropValue::Block(b)) => self.section(v, &b, format!("{}.section", v.name)),
@@ -171,6 +219,7 @@ impl Builder<'_> {
             None => Some(None),
         };
         Some(Layout {
+            points: points?,
             from: from?,
             to: to?,
             section: section?,
@@ -224,138 +273,28 @@ impl Builder<'_> {
         (elements, order)
     }
 
-    /// `twist`: an angle, or stations `((s, angle), ...)` with `s` the arc length from `from`.
-    fn twist(&mut self, scope: usize, e: &crate::syntax::ast::Expr) -> Option<Vec<(f64, f64)>> {
+    /// `points = (P1, P2, ...)`: lengths, each point a vector.
+    fn points(&mut self, scope: usize, e: &crate::syntax::ast::Expr) -> Option<Vec<[f64; 3]>> {
         use crate::syntax::ast::ExprKind;
-        let rows = match &e.kind {
-            ExprKind::Vector { items, unit: None }
-                if items
-                    .iter()
-                    .all(|r| matches!(&r.kind, ExprKind::Vector { .. })) =>
-            {
-                items
-            }
-            _ => {
-                let x = self.scalar(scope, e, units::ANGLE, "`twist`");
-                if x.is_some() {
-                    self.angle_unit(scope, Some(e), x, "`twist`");
-                }
-                return x.map(|a| vec![(0.0, a)]);
-            }
-        };
-        let mut out = Vec::with_capacity(rows.len());
-        for row in rows {
-            let ExprKind::Vector { items, unit: None } = &row.kind else {
-                continue;
-            };
-            if items.len() != 2 {
-                self.error(
-                    scope,
-                    Diagnostic::error(Code::E0209, "a twist station is an arc length and an angle")
-                        .at(row.span, format!("{} entries", items.len()))
-                        .hint("write `twist = ((0 m, 0 deg), (2.5 m, -8 deg))`: each station `(s, angle)`, s from the beam's `from`, each entry with its unit"),
-                );
-                return None;
-            }
-            let s = self.scalar(
+        let ExprKind::Vector { items, unit: None } = &e.kind else {
+            self.error(
                 scope,
-                &items[0],
-                Dim::LENGTH,
-                "a twist station's arc length",
+                Diagnostic::error(Code::E0209, "`points` is a list of points")
+                    .at(e.span, "not a list of points")
+                    .hint("write `points = ((0, 0, 0) m, (1, 0, 0) m, (1.5, 0.5, 0) m)`"),
             );
-            let a = self.scalar(scope, &items[1], units::ANGLE, "a twist station's angle");
-            if a.is_some() {
-                self.angle_unit(scope, Some(&items[1]), a, "a twist station's angle");
-            }
-            out.push((s?, a?));
-        }
-        Some(out)
-    }
-
-    /// `section = ((s, NAME), ...)`: sections at stations, each a declared section.
-    fn section_stations(
-        &mut self,
-        v: &View,
-        e: &crate::syntax::ast::Expr,
-    ) -> Option<Vec<(f64, Section)>> {
-        let mut out = Vec::new();
-        for items in stations(e)? {
-            if items.len() != 2 {
-                self.error(
-                    v.scope,
-                    Diagnostic::error(Code::E0209, "a section station is an arc length and a section")
-                        .at(e.span, format!("a station with {} entries", items.len()))
-                        .hint("write `section = ((0 m, root), (2.5 m, tip))`: each station `(s, NAME)`, s from the beam's `from`, NAME a declared section"),
-                );
-                return None;
-            }
-            let s = self.scalar(
-                v.scope,
-                &items[0],
-                Dim::LENGTH,
-                "a section station's arc length",
-            );
-            let section = self.section_ref(v, &items[1]);
-            out.push((s?, section?));
-        }
-        Some(out)
-    }
-
-    /// Stations (of the twist or the section, `what`) within the beam (`0 <= s <= length`), in
-    /// increasing arc length; `refuse` says why the beam takes none.
-    fn check_stations(
-        &mut self,
-        v: &View,
-        what: &str,
-        (at, span): (&[f64], Span),
-        length: f64,
-        refuse: Option<&str>,
-    ) -> Option<()> {
-        let inside = at
+            return None;
+        };
+        let points: Vec<Option<[f64; 3]>> = items
             .iter()
-            .all(|&s| (-1e-12 * length..=length * (1.0 + 1e-12)).contains(&s));
-        let increasing = at.windows(2).all(|w| w[1] > w[0]);
-        let problem = if at.is_empty() {
-            Some("no station")
-        } else if !inside {
-            Some("a station outside the beam")
-        } else if !increasing {
-            Some("stations not in increasing arc length")
-        } else {
-            refuse
-        };
-        let Some(problem) = problem else {
-            return Some(());
-        };
-        self.error(
-            v.scope,
-            Diagnostic::error(Code::E0213, format!("the {what} of beam `{}` has {problem}", v.name))
-                .at(span, problem)
-                .hint(format!("give stations `(s, {what})` with s increasing from 0 to the beam's length ({length} m); a `rigid` beam takes one {what}, and `spin_stretch` one section")),
-        );
-        None
+            .map(|x| self.vector(scope, x, Dim::LENGTH, "a point of `points`"))
+            .collect();
+        points.into_iter().collect()
     }
 
     /// The beam's axis 1 and its section frame at t = 0 before the twist (axis 2 from `e2` or
     /// a default across the beam).
-    fn section_frame(
-        &mut self,
-        v: &View,
-        p: &Props,
-        d: [f64; 3],
-        b: &Layout,
-    ) -> Option<([f64; 3], Mat3)> {
-        let length = norm(d);
-        if length == 0.0 {
-            self.error(
-                v.scope,
-                Diagnostic::error(Code::E0303, format!("beam `{}` has zero length", v.name))
-                    .at(v.name_span, "`from` and `to` coincide")
-                    .hint("place `to` away from `from`"),
-            );
-            return None;
-        }
-        let e1 = scale(d, 1.0 / length);
+    fn section_frame(&mut self, v: &View, p: &Props, e1: [f64; 3], b: &Layout) -> Option<Mat3> {
         let guess = b.e2.unwrap_or(if e1[2].abs() < 0.999 {
             cross([0.0, 0.0, 1.0], e1)
         } else {
@@ -384,7 +323,64 @@ impl Builder<'_> {
             [e1[1], e2[1], e3[1]],
             [e1[2], e2[2], e3[2]],
         ];
-        Some((e1, base))
+        Some(base)
+    }
+
+    /// A straight beam's axis 1, from `from` to `to` (`d`).
+    fn axis(&mut self, v: &View, d: [f64; 3]) -> Option<[f64; 3]> {
+        let length = norm(d);
+        if length == 0.0 {
+            self.error(
+                v.scope,
+                Diagnostic::error(Code::E0303, format!("beam `{}` has zero length", v.name))
+                    .at(v.name_span, "`from` and `to` coincide")
+                    .hint("place `to` away from `from`"),
+            );
+            return None;
+        }
+        Some(scale(d, 1.0 / length))
+    }
+
+    /// The reference line through `points` (a polyline with the `polyline` flag, else the
+    /// smooth curve through them); `straight_only`: the beam is `rigid` or starts with
+    /// `spin_stretch`, which need a straight beam.
+    fn curve(
+        &mut self,
+        v: &View,
+        points: &[[f64; 3]],
+        span: Span,
+        straight_only: bool,
+    ) -> Option<Curve> {
+        let problem = if straight_only {
+            Some((
+                Code::E0213,
+                "is `rigid` or starts with `spin_stretch`, which need a straight beam",
+                "give `from` and `to` for a straight beam, or drop `rigid` and `spin_stretch`"
+                    .to_string(),
+            ))
+        } else if points.len() < 2 {
+            Some((Code::E0209, "needs two points or more", EXAMPLE.to_string()))
+        } else {
+            None
+        };
+        let curve = match problem {
+            Some(_) => None,
+            None => Curve::new(points, Self::has_flag(v, "polyline")),
+        };
+        if curve.is_none() {
+            let (code, what, hint) = problem.unwrap_or((
+                Code::E0303,
+                "cannot follow points that coincide",
+                format!("consecutive points must be apart; {EXAMPLE}"),
+            ));
+            self.error(
+                v.scope,
+                Diagnostic::error(code, format!("curved beam `{}` {what}", v.name))
+                    .at(span, "the reference line's points")
+                    .hint(hint),
+            );
+        }
+        curve
     }
 
     /// The nodes at t = 0: with `spin_stretch`, the steady centrifugal stretch of a beam
@@ -487,33 +483,4 @@ impl Builder<'_> {
             },
         )
     }
-}
-
-/// The twist at arc length `s`: linear between the stations, held beyond the ends.
-pub(super) fn twist_at(stations: &[(f64, f64)], s: f64) -> f64 {
-    match stations {
-        [] => 0.0,
-        [(s0, a0), ..] if s <= *s0 => *a0,
-        [.., (sl, al)] if s >= *sl => *al,
-        _ => stations.windows(2).find(|w| s <= w[1].0).map_or(0.0, |w| {
-            let f = (s - w[0].0) / (w[1].0 - w[0].0);
-            w[0].1 + f * (w[1].1 - w[0].1)
-        }),
-    }
-}
-
-/// The rows of a table of stations, `((a, b), (c, d), ...)`: a vector of vectors (no unit
-/// after the outer parenthesis, none after the rows); `None` if `e` is not one.
-fn stations(e: &crate::syntax::ast::Expr) -> Option<Vec<Vec<crate::syntax::ast::Expr>>> {
-    use crate::syntax::ast::ExprKind;
-    let ExprKind::Vector { items, unit: None } = &e.kind else {
-        return None;
-    };
-    items
-        .iter()
-        .map(|r| match &r.kind {
-            ExprKind::Vector { items, unit: None } => Some(items.clone()),
-            _ => None,
-        })
-        .collect()
 }

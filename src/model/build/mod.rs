@@ -9,6 +9,7 @@ mod beams;
 mod bodies;
 mod center_of_mass;
 mod connect;
+mod curve;
 mod exact;
 mod initial;
 mod joints;
@@ -18,6 +19,7 @@ mod outputs;
 mod probes;
 mod sections;
 mod solve;
+mod stations;
 mod unused;
 mod values;
 
