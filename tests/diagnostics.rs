@@ -27,6 +27,7 @@ const CASES: &[(&str, &[Code])] = &[
     ("unknown_newton_mode", &[Code::E0211]),
     ("twist_stations", &[Code::E0213, Code::E0209, Code::E0213]),
     ("curve_points", &[Code::E0224, Code::E0303, Code::E0213]),
+    ("section_centres", &[Code::E0224]),
     ("joint_to_itself", &[Code::E0301]),
     ("negative_mass", &[Code::E0302]),
     ("zero_length", &[Code::E0303]),

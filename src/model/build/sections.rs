@@ -51,6 +51,10 @@ impl Builder<'_> {
                 "i2",
                 "i3",
                 "polar",
+                "tension_offset2",
+                "tension_offset3",
+                "shear_offset2",
+                "shear_offset3",
             ],
             "a section",
         );
@@ -90,13 +94,20 @@ impl Builder<'_> {
         let mut k = [[0.0; 6]; 6];
         let mut ok = true;
         if let Some(sp) = p.get("stiffness") {
-            if let Some((name, _)) = DIAG.iter().find(|(n, _)| p.contains_key(n)) {
+            const OFFSETS: [&str; 4] = [
+                "tension_offset2",
+                "tension_offset3",
+                "shear_offset2",
+                "shear_offset3",
+            ];
+            let diagonal = DIAG.iter().map(|(n, _)| *n).chain(OFFSETS);
+            if let Some(name) = diagonal.into_iter().find(|n| p.contains_key(n)) {
                 self.error(
                     v.scope,
-                    Diagnostic::error(Code::E0224, "a section gives either `stiffness` (6x6) or the diagonal stiffnesses, not both")
-                        .at(p.get(name).map(|q| q.name.span).unwrap_or(sp.name.span), "diagonal stiffness")
+                    Diagnostic::error(Code::E0224, "a section gives either `stiffness` (6x6) or the diagonal stiffnesses and centres, not both")
+                        .at(p.get(name).map(|q| q.name.span).unwrap_or(sp.name.span), "engineering property")
                         .at(sp.name.span, "full matrix")
-                        .hint("keep one of them"),
+                        .hint("keep one of them: a 6x6 `stiffness` already holds the couplings that offset centres give"),
                 );
                 return None;
             }
@@ -111,6 +122,20 @@ impl Builder<'_> {
                     Some(x) => k[i][i] = x,
                     None => ok = false,
                 }
+            }
+            let mut offset = |key: &str| match self.expr(v.scope, p.get(key)) {
+                Some(e) => self.scalar(v.scope, e, Dim::LENGTH, &format!("`{key}`")),
+                None => Some(0.0),
+            };
+            let (t2, t3, s2, s3) = (
+                offset("tension_offset2"),
+                offset("tension_offset3"),
+                offset("shear_offset2"),
+                offset("shear_offset3"),
+            );
+            match (t2, t3, s2, s3) {
+                (Some(t2), Some(t3), Some(s2), Some(s3)) => offsets(&mut k, [t2, t3], [s2, s3]),
+                _ => ok = false,
             }
         }
         Some((k, ok))
@@ -340,5 +365,30 @@ fn scalar_of(v: &Value) -> f64 {
     match v {
         Value::Scalar { value, .. } => *value,
         _ => 1.0,
+    }
+}
+
+/// The stiffness about the reference line of a section whose axial stiffness acts at the
+/// tension centre `t` and whose shear stiffnesses act at the shear centre `c` (offsets along
+/// axes 2, 3; `k` holds the diagonal, bending and torsion about those centres). A fibre at
+/// `(x2, x3)` stretches by `gamma1 + x3 kappa2 - x2 kappa3`, and the shear centre moves across
+/// by `(-c3, c2) kappa1` under a twist, so the strains there are
+/// `gamma1 + t3 kappa2 - t2 kappa3`, `gamma2 - c3 kappa1` and `gamma3 + c2 kappa1`.
+fn offsets(k: &mut [[f64; 6]; 6], t: [f64; 2], c: [f64; 2]) {
+    // Each stiffness with its strain as a combination of the reference line's.
+    let (ea, ga2, ga3) = (k[0][0], k[1][1], k[2][2]);
+    let rows: [(f64, [f64; 6]); 3] = [
+        (ea, [1.0, 0.0, 0.0, 0.0, t[1], -t[0]]),
+        (ga2, [0.0, 1.0, 0.0, -c[1], 0.0, 0.0]),
+        (ga3, [0.0, 0.0, 1.0, c[0], 0.0, 0.0]),
+    ];
+    for (r, (stiffness, b)) in rows.iter().enumerate() {
+        // Replace the diagonal entry by the full b^T stiffness b.
+        k[r][r] = 0.0;
+        for i in 0..6 {
+            for j in 0..6 {
+                k[i][j] += stiffness * b[i] * b[j];
+            }
+        }
     }
 }
