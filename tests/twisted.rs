@@ -286,6 +286,13 @@ fn a_tapered_cantilever_bends_as_its_varying_section_says() {
     }
 }
 
+/// The part of a response linear in the load `p`: `2 d(p) - d(2 p) / 2` cancels the part of
+/// second order.
+fn linear(run: impl Fn(f64) -> (f64, f64), p: f64) -> (f64, f64) {
+    let ((a1, b1), (a2, b2)) = (run(p), run(2.0 * p));
+    (2.0 * a1 - a2 / 2.0, 2.0 * b1 - b2 / 2.0)
+}
+
 /// A quarter circle of radius 1 m in the xy plane, clamped at (1, 0, 0), its tip at (0, 1, 0)
 /// pushed along +x by `P` in one load step; the reference line through `count` points of
 /// the circle (`polyline`: the flag, else the smooth curve), `elements` cubic elements.
@@ -339,10 +346,7 @@ fn a_curved_cantilever_bends_as_castigliano_says() {
     let errors: Vec<f64> = [2, 4, 8]
         .iter()
         .map(|&n| {
-            // The linear response: `2 d(P) - d(2 P) / 2` cancels the part of second order.
-            let (x1, y1) = quarter_circle(33, n, "", p);
-            let (x2, y2) = quarter_circle(33, n, "", 2.0 * p);
-            let (x, y) = (2.0 * x1 - x2 / 2.0, 2.0 * y1 - y2 / 2.0);
+            let (x, y) = linear(|load| quarter_circle(33, n, "", load), p);
             (x - ex).hypot(y - ey) / size
         })
         .collect();
@@ -417,19 +421,20 @@ solve static {{ steps = 1, until = 1 s }}
 #[test]
 fn offset_tension_and_shear_centres_bend_and_twist_as_statics_says() {
     let f = 1e-3;
-    let linear = |offsets: &str, force: &str| {
-        let (z1, c1) = offset_section(offsets, force, f);
-        let (z2, c2) = offset_section(offsets, force, 2.0 * f);
-        (2.0 * z1 - z2 / 2.0, 2.0 * c1 - c2 / 2.0)
-    };
-    let (z, _) = linear("tension_offset3 = 0.05 m", "(f * t / 1 s, 0, 0)");
+    let (z, _) = linear(
+        |load| offset_section("tension_offset3 = 0.05 m", "(f * t / 1 s, 0, 0)", load),
+        f,
+    );
     let rise = f * 0.05 / (2.0 * 10.0);
     within(
         "tension centre 0.05 m above the reference line: tip rise against F t3 L^2 / (2 EI2)",
         (z - rise).abs() / rise,
         1e-8,
     );
-    let (_, twist) = linear("shear_offset2 = 0.04 m", "(0, 0, f * t / 1 s)");
+    let (_, twist) = linear(
+        |load| offset_section("shear_offset2 = 0.04 m", "(0, 0, f * t / 1 s)", load),
+        f,
+    );
     let expected = -0.04 * f / 5.0;
     within(
         "shear centre 0.04 m aside: tip twist against -c2 F L / GJ",

@@ -101,9 +101,8 @@ pub(super) fn by_krylov(
         integrate(it)
     };
     newton_iterations += to_phase(it, lifted)?;
-    let weights = it
-        .direction_weights()
-        .expect("the directions are tracked from the restart on");
+    // The weights exist once `track` was called (in `to_phase`); `weighted` of none is empty.
+    let weights = it.direction_weights().unwrap_or_default();
     let first = weighted(it.tracked().unwrap_or_default(), &weights);
     let mut basis = vec![first.qr().q()];
     let mut h = DMatrix::<f64>::zeros(b, 0);
