@@ -8,6 +8,7 @@ mod charts;
 mod cli;
 mod common;
 mod diagnostics;
+mod distributed;
 mod docs;
 mod emit;
 mod fet;

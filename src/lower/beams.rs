@@ -3,8 +3,9 @@
 
 use super::Lower;
 use crate::model::{Beam, Section};
-use crate::runtime::beams::SectionAt;
+use crate::runtime::beams::{inertial_points, Distributed, SectionAt};
 use crate::runtime::rotation::{M3, V3};
+use crate::runtime::LoadKind;
 use crate::runtime::{
     arr3, m3, BeamElement, Element, NodeRotation, Probe, ProbeQuantity, RigidBody, State,
 };
@@ -74,14 +75,31 @@ pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initia
             .flat_map(|&k| starts[k]..starts[k] + 6)
             .collect();
         let positions: Vec<[f64; 3]> = local.iter().map(|&k| b.nodes[k]).collect();
-        elements.push(Element::Beam(BeamElement::new(
+        let span = |xi: f64| le * (e as f64 + (xi + 1.0) / 2.0);
+        let mut element = BeamElement::new(
             dofs,
             local.iter().map(|&k| ids[k]).collect(),
             &positions,
             local.iter().map(|&k| b.frames[k]).collect(),
-            &|xi: f64| section_at(b, le * (e as f64 + (xi + 1.0) / 2.0)),
+            &|xi: f64| section_at(b, span(xi)),
             model.gravity,
-        )));
+        );
+        // Distributed loads: their values at the inertial points, `span` replaced there.
+        for d in model.distributed.iter().filter(|d| d.beam == bi) {
+            let values = inertial_points(p)
+                .iter()
+                .map(|&xi| d.value.each_ref().map(|f| f.at_arc(span(xi))))
+                .collect();
+            element.loads.push(Distributed {
+                kind: match d.kind {
+                    crate::model::LoadKind::Force => LoadKind::Force,
+                    crate::model::LoadKind::Torque => LoadKind::Torque,
+                },
+                follower: d.follower,
+                values,
+            });
+        }
+        elements.push(Element::Beam(element));
     }
     // Concentrated masses: rigid bodies on the node, centred there.
     for &(node, mass, inertia) in &b.point_masses {

@@ -73,6 +73,8 @@ pub struct Model {
     pub joints: Vec<Joint>,
     pub springs: Vec<Spring>,
     pub loads: Vec<Load>,
+    /// Forces and torques per length along beams.
+    pub distributed: Vec<DistributedLoad>,
     pub outputs: Vec<OutputChannel>,
     /// Closed-form solutions of output channels (`exact phi = Omega * t`).
     pub exact: Vec<ExactReference>,
@@ -323,6 +325,19 @@ pub struct Load {
     pub kind: LoadKind,
     pub marker: Marker,
     /// Components (inertial, or in the marker's axes if `follower`).
+    pub value: [TimeFn; 3],
+    pub follower: bool,
+}
+
+/// A force or torque per length along a whole beam, a vector function of the time `t` and of
+/// the arc length `span` ([`TimeFn::Arc`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct DistributedLoad {
+    pub name: String,
+    pub span: Span,
+    pub kind: LoadKind,
+    pub beam: usize,
+    /// Components per length (inertial, or in the section's axes if `follower`).
     pub value: [TimeFn; 3],
     pub follower: bool,
 }

@@ -53,6 +53,9 @@ pub enum TimeFn {
     },
     /// The time `t` in seconds.
     Time,
+    /// The arc length along a beam in metres (`span`), in a distributed load's value only:
+    /// replaced by its value at each quadrature point before a run ([`TimeFn::at_arc`]).
+    Arc,
     Unary {
         op: Unary,
         arg: Box<TimeFn>,
@@ -122,18 +125,52 @@ impl TimeFn {
 
     /// This function with `t` replaced by `inner` (composition `self(inner(t))`).
     pub fn compose(&self, inner: &TimeFn) -> TimeFn {
+        self.substitute(&|f| matches!(f, TimeFn::Time).then(|| inner.clone()))
+    }
+
+    /// This function at arc length `s` (metres) along a beam: `span` replaced by `s`, and a
+    /// function left without `t` evaluated once to its constant.
+    pub fn at_arc(&self, s: f64) -> TimeFn {
+        let f =
+            self.substitute(&|f| matches!(f, TimeFn::Arc).then_some(TimeFn::Const { value: s }));
+        if f.depends(&|f| matches!(f, TimeFn::Time)) {
+            f
+        } else {
+            TimeFn::constant(f.eval(0.0))
+        }
+    }
+
+    /// Whether the function depends on the span coordinate `span`.
+    pub fn has_arc(&self) -> bool {
+        self.depends(&|f| matches!(f, TimeFn::Arc))
+    }
+
+    /// Whether any leaf of the tree satisfies `leaf`.
+    fn depends(&self, leaf: &dyn Fn(&TimeFn) -> bool) -> bool {
         match self {
-            TimeFn::Const { value } => TimeFn::Const { value: *value },
-            TimeFn::Time => inner.clone(),
+            TimeFn::Const { .. } | TimeFn::Time | TimeFn::Arc => leaf(self),
+            TimeFn::Unary { arg, .. } | TimeFn::Pow { arg, .. } | TimeFn::Piecewise { arg, .. } => {
+                arg.depends(leaf)
+            }
+            TimeFn::Binary { lhs, rhs, .. } => lhs.depends(leaf) || rhs.depends(leaf),
+        }
+    }
+
+    /// The tree with each leaf for which `leaf` gives a replacement replaced.
+    fn substitute(&self, leaf: &dyn Fn(&TimeFn) -> Option<TimeFn>) -> TimeFn {
+        match self {
+            TimeFn::Const { .. } | TimeFn::Time | TimeFn::Arc => {
+                leaf(self).unwrap_or_else(|| self.clone())
+            }
             TimeFn::Unary { op, arg } => TimeFn::Unary {
                 op: *op,
-                arg: Box::new(arg.compose(inner)),
+                arg: Box::new(arg.substitute(leaf)),
             },
             TimeFn::Binary { op, lhs, rhs } => {
-                TimeFn::binary(*op, lhs.compose(inner), rhs.compose(inner))
+                TimeFn::binary(*op, lhs.substitute(leaf), rhs.substitute(leaf))
             }
             TimeFn::Pow { arg, exponent } => TimeFn::Pow {
-                arg: Box::new(arg.compose(inner)),
+                arg: Box::new(arg.substitute(leaf)),
                 exponent: *exponent,
             },
             TimeFn::Piecewise {
@@ -143,7 +180,7 @@ impl TimeFn {
             } => TimeFn::Piecewise {
                 knots: knots.clone(),
                 outside: *outside,
-                arg: Box::new(arg.compose(inner)),
+                arg: Box::new(arg.substitute(leaf)),
             },
         }
     }
@@ -161,40 +198,9 @@ impl TimeFn {
                 d: 1.0,
                 dd: 0.0,
             },
-            TimeFn::Unary { op, arg } => {
-                let a = arg.jet(t);
-                let x = a.v;
-                match op {
-                    Unary::Sin => a.chain(x.sin(), x.cos(), -x.sin()),
-                    Unary::Cos => a.chain(x.cos(), -x.sin(), -x.cos()),
-                    Unary::Tan => {
-                        let c2 = 1.0 / (x.cos() * x.cos());
-                        a.chain(x.tan(), c2, 2.0 * x.tan() * c2)
-                    }
-                    Unary::Asin => {
-                        let s = 1.0 - x * x;
-                        a.chain(x.asin(), 1.0 / s.sqrt(), x / (s * s.sqrt()))
-                    }
-                    Unary::Acos => {
-                        let s = 1.0 - x * x;
-                        a.chain(x.acos(), -1.0 / s.sqrt(), -x / (s * s.sqrt()))
-                    }
-                    Unary::Atan => {
-                        let s = 1.0 + x * x;
-                        a.chain(x.atan(), 1.0 / s, -2.0 * x / (s * s))
-                    }
-                    Unary::Sqrt => {
-                        let r = x.sqrt();
-                        a.chain(r, 0.5 / r, -0.25 / (r * x))
-                    }
-                    Unary::Abs => {
-                        let s = if x < 0.0 { -1.0 } else { 1.0 };
-                        a.chain(x.abs(), s, 0.0)
-                    }
-                    Unary::Exp => a.chain(x.exp(), x.exp(), x.exp()),
-                    Unary::Ln => a.chain(x.ln(), 1.0 / x, -1.0 / (x * x)),
-                }
-            }
+            // Never reached in a run: the lowering replaces it (`at_arc`); NaN if it were.
+            TimeFn::Arc => Jet::constant(f64::NAN),
+            TimeFn::Unary { op, arg } => unary(*op, arg.jet(t)),
             TimeFn::Binary { op, lhs, rhs } => {
                 let (a, b) = (lhs.jet(t), rhs.jet(t));
                 match op {
@@ -272,6 +278,41 @@ impl TimeFn {
                 a.chain(v, slope, 0.0)
             }
         }
+    }
+}
+
+/// A unary function's jet from its argument's.
+fn unary(op: Unary, a: Jet) -> Jet {
+    let x = a.v;
+    match op {
+        Unary::Sin => a.chain(x.sin(), x.cos(), -x.sin()),
+        Unary::Cos => a.chain(x.cos(), -x.sin(), -x.cos()),
+        Unary::Tan => {
+            let c2 = 1.0 / (x.cos() * x.cos());
+            a.chain(x.tan(), c2, 2.0 * x.tan() * c2)
+        }
+        Unary::Asin => {
+            let s = 1.0 - x * x;
+            a.chain(x.asin(), 1.0 / s.sqrt(), x / (s * s.sqrt()))
+        }
+        Unary::Acos => {
+            let s = 1.0 - x * x;
+            a.chain(x.acos(), -1.0 / s.sqrt(), -x / (s * s.sqrt()))
+        }
+        Unary::Atan => {
+            let s = 1.0 + x * x;
+            a.chain(x.atan(), 1.0 / s, -2.0 * x / (s * s))
+        }
+        Unary::Sqrt => {
+            let r = x.sqrt();
+            a.chain(r, 0.5 / r, -0.25 / (r * x))
+        }
+        Unary::Abs => {
+            let s = if x < 0.0 { -1.0 } else { 1.0 };
+            a.chain(x.abs(), s, 0.0)
+        }
+        Unary::Exp => a.chain(x.exp(), x.exp(), x.exp()),
+        Unary::Ln => a.chain(x.ln(), 1.0 / x, -1.0 / (x * x)),
     }
 }
 

@@ -55,6 +55,19 @@ impl Builder<'_> {
             };
             let f = match &v {
                 Value::Scalar { value, .. } => crate::runtime::timefn::TimeFn::constant(*value),
+                Value::Signal { parts, .. } if parts.len() == 1 && parts[0].has_arc() => {
+                    let d = Diagnostic::error(
+                        Code::E0401,
+                        format!(
+                            "the exact solution of `{}` cannot depend on `span`",
+                            column.column
+                        ),
+                    )
+                    .at(value.span, "this varies along a beam")
+                    .hint(super::values::SPAN_HINT);
+                    self.error(scope, d);
+                    continue;
+                }
                 Value::Signal { parts, .. } if parts.len() == 1 => parts[0].clone(),
                 _ => {
                     let d = Diagnostic::error(

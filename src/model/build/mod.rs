@@ -10,6 +10,7 @@ mod bodies;
 mod center_of_mass;
 mod connect;
 mod curve;
+mod distributed;
 mod exact;
 mod initial;
 mod joints;
@@ -46,6 +47,7 @@ pub(super) enum Built {
     Joint(usize),
     Spring(usize),
     Load(usize),
+    Distributed(usize),
     Mass,
 }
 
@@ -74,6 +76,9 @@ pub(super) struct Builder<'s> {
     pub joints: Vec<Joint>,
     pub springs: Vec<Spring>,
     pub loads: Vec<Load>,
+    pub distributed: Vec<DistributedLoad>,
+    /// Set while a distributed load's value is built: the only place `span` may appear.
+    pub span_allowed: bool,
     pub built: Vec<Option<Built>>,
     /// Declaration spans of bodies and beams (for topology messages).
     pub body_decl: Vec<usize>,
@@ -94,6 +99,8 @@ pub(super) const KINDS: &[&str] = &[
     "torsional_damper",
     "force",
     "torque",
+    "distributed_force",
+    "distributed_torque",
     "concentrated_mass",
 ];
 
@@ -187,6 +194,7 @@ fn build_model(
         joints: b.joints,
         springs: b.springs,
         loads: b.loads,
+        distributed: b.distributed,
         outputs,
         exact,
         solve: solve?,
@@ -249,6 +257,8 @@ impl<'s> Builder<'s> {
             joints: Vec::new(),
             springs: Vec::new(),
             loads: Vec::new(),
+            distributed: Vec::new(),
+            span_allowed: false,
             body_decl: Vec::new(),
             beam_decl: Vec::new(),
         }
@@ -373,6 +383,7 @@ impl<'s> Builder<'s> {
             "section" => self.section_decl(v),
             "spring" | "damper" | "torsional_spring" | "torsional_damper" => self.spring(v),
             "force" | "torque" => self.load(v),
+            "distributed_force" | "distributed_torque" => self.distributed_load(v),
             "concentrated_mass" => self.concentrated_mass(v),
             other => {
                 let hint = match did_you_mean(other, KINDS.iter().copied()) {

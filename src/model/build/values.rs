@@ -12,6 +12,9 @@ use crate::model::*;
 use crate::syntax::ast::{Block, Expr, Prop, PropValue};
 use std::collections::HashMap;
 
+/// Where `span` may appear.
+pub(super) const SPAN_HINT: &str = "`span` is the arc length along a beam: only a distributed load (`distributed_force`, `distributed_torque`) may depend on it";
+
 impl Builder<'_> {
     /// Checks the parts a declaration has against those its kind takes.
     pub fn shape(
@@ -177,6 +180,13 @@ impl Builder<'_> {
     ) -> Option<Value> {
         let v = self.value(scope, e)?;
         let error = match (&v, vector) {
+            (Value::Signal { parts, .. }, _) if parts.iter().any(TimeFn::has_arc) => {
+                Diagnostic::error(
+                    Code::E0401,
+                    format!("{what} must be a constant, found a function of `span`"),
+                )
+                .at(e.span, "this varies along a beam")
+            }
             (Value::Signal { .. }, _) => Diagnostic::error(
                 Code::E0401,
                 format!("{what} must be a constant, found a function of time"),
@@ -199,7 +209,12 @@ impl Builder<'_> {
             _ if v.dim() != want.dim => self.mismatch(scope, e, want, v.dim(), what),
             _ => return Some(v),
         };
-        let hint = if let Value::Signal { .. } = v {
+        let hint = if v
+            .parts()
+            .is_some_and(|(p, _)| p.iter().any(TimeFn::has_arc))
+        {
+            SPAN_HINT.to_string()
+        } else if let Value::Signal { .. } = v {
             "only loads, prescribed motions and functions may depend on `t`".to_string()
         } else if vector && !matches!(v, Value::Vector { .. }) {
             format!("write `(x, y, z)`; {}", unit_hint(want, vector))
@@ -301,6 +316,18 @@ impl Builder<'_> {
         let want = want.into();
         let v = self.value(scope, e)?;
         let parts = v.parts();
+        if !self.span_allowed {
+            if let Some((p, _)) = &parts {
+                if p.iter().any(TimeFn::has_arc) {
+                    let d =
+                        Diagnostic::error(Code::E0401, format!("{what} cannot depend on `span`"))
+                            .at(e.span, "this varies along a beam")
+                            .hint(SPAN_HINT);
+                    self.error(scope, d);
+                    return None;
+                }
+            }
+        }
         let count = if vector { 3 } else { 1 };
         match parts {
             Some((p, d)) if p.len() == count && d == want.dim => Some(p),

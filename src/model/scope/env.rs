@@ -141,14 +141,14 @@ pub enum Ref {
     Decl(DeclId),
     Instance(ScopeId),
     Component(Rc<Component>),
-    /// `t`, `pi`, `x`, `y`, `z`.
+    /// `t`, `span`, `pi`, `x`, `y`, `z`.
     Builtin(Value),
     /// A whole indexed family, its members in index order (only from
     /// [`Env::resolve_family`]).
     Family(Vec<(i64, Member)>),
 }
 
-const BUILTINS: &[&str] = &["t", "pi", "x", "y", "z", "true", "false"];
+const BUILTINS: &[&str] = &["t", "span", "pi", "x", "y", "z", "true", "false"];
 
 pub(super) fn builtin(name: &str) -> Option<Value> {
     let unit = |k: usize| {
@@ -163,6 +163,10 @@ pub(super) fn builtin(name: &str) -> Option<Value> {
         "t" => Value::Signal {
             parts: vec![TimeFn::Time],
             dim: Dim::TIME,
+        },
+        "span" => Value::Signal {
+            parts: vec![TimeFn::Arc],
+            dim: Dim::LENGTH,
         },
         "pi" => Value::scalar(std::f64::consts::PI, Dim::NONE),
         "true" => Value::scalar(1.0, Dim::NONE),

@@ -330,7 +330,23 @@ fn beam_case(rng: &mut Lcg, nn: usize) -> (BeamElement, State) {
         &section,
         rng.v3(),
     );
-    beam.load = rng.v3();
+    // Distributed loads: fixed and follower forces and torques, different at every point.
+    let points = beam.inertial.len();
+    for (kind, follower) in [
+        (LoadKind::Force, false),
+        (LoadKind::Force, true),
+        (LoadKind::Torque, true),
+        (LoadKind::Torque, false),
+    ] {
+        let values = (0..points)
+            .map(|_| rng.v3().map(TimeFn::constant))
+            .collect();
+        beam.loads.push(crate::runtime::beams::Distributed {
+            kind,
+            follower,
+            values,
+        });
+    }
     let mut st = State::zeros(6 * nn, nn);
     for k in 0..nn {
         for i in 0..3 {

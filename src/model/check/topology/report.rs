@@ -47,10 +47,14 @@ pub fn report(model: &Model) -> String {
             );
         }
     }
-    if !model.springs.is_empty() || !model.loads.is_empty() {
+    if !model.springs.is_empty() || !model.loads.is_empty() || !model.distributed.is_empty() {
+        let along = match model.distributed.len() {
+            0 => String::new(),
+            n => format!(", {n} along beams"),
+        };
         let _ = writeln!(
             s,
-            "springs and loads: {} springs/dampers, {} loads",
+            "springs and loads: {} springs/dampers, {} loads{along}",
             model.springs.len(),
             model.loads.len()
         );

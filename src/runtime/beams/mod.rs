@@ -23,30 +23,14 @@ use super::rotation::{
 use super::{m3, Energy, MassMoments, Residual, State, TangentCoeffs};
 use serde::{Deserialize, Serialize};
 
+mod loads;
+mod quadrature;
+pub use loads::Distributed;
+use quadrature::gauss;
+pub use quadrature::{inertial_points, shape, Gauss, SectionAt};
+
 /// Most nodes of an element.
 const MAXN: usize = 4;
-
-/// One quadrature point: weight times Jacobian, shape functions and their arc-length
-/// derivatives, the reference strains `(gamma*_0, kappa*_0)` and the section there.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Gauss {
-    pub wj: f64,
-    pub n: [f64; MAXN],
-    pub dn: [f64; MAXN],
-    pub strain0: [f64; 6],
-    pub section: SectionAt,
-}
-
-/// A section's properties at a point, in the section frame: the stiffness (forces, then
-/// moments), the mass per length, the centre-of-mass offset and the inertia per length about
-/// the reference line.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct SectionAt {
-    pub stiffness: [[f64; 6]; 6],
-    pub mass: f64,
-    pub eta: [f64; 3],
-    pub rho: [[f64; 3]; 3],
-}
 
 /// A beam element.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -58,64 +42,11 @@ pub struct BeamElement {
     /// Section triad of each node at t = 0 (columns: axes 1, 2, 3).
     pub triads: Vec<[[f64; 3]; 3]>,
     pub gravity: [f64; 3],
-    /// Distributed force per length (inertial), fixed.
-    pub load: [f64; 3],
+    /// Distributed loads per length, their values at the inertial points.
+    pub loads: Vec<Distributed>,
     /// Reduced points (elastic terms) and full points (inertial terms).
     pub elastic: Vec<Gauss>,
     pub inertial: Vec<Gauss>,
-}
-
-/// Gauss points and weights on [-1, 1] for 1 to 4 points.
-fn gauss(n: usize) -> (&'static [f64], &'static [f64]) {
-    const X1: [f64; 1] = [0.0];
-    const W1: [f64; 1] = [2.0];
-    const X2: [f64; 2] = [-0.577_350_269_189_625_8, 0.577_350_269_189_625_8];
-    const W2: [f64; 2] = [1.0, 1.0];
-    const X3: [f64; 3] = [-0.774_596_669_241_483_4, 0.0, 0.774_596_669_241_483_4];
-    const W3: [f64; 3] = [5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0];
-    const X4: [f64; 4] = [
-        -0.861_136_311_594_052_6,
-        -0.339_981_043_584_856_3,
-        0.339_981_043_584_856_3,
-        0.861_136_311_594_052_6,
-    ];
-    const W4: [f64; 4] = [
-        0.347_854_845_137_453_9,
-        0.652_145_154_862_546_1,
-        0.652_145_154_862_546_1,
-        0.347_854_845_137_453_9,
-    ];
-    match n {
-        1 => (&X1, &W1),
-        2 => (&X2, &W2),
-        3 => (&X3, &W3),
-        _ => (&X4, &W4),
-    }
-}
-
-/// Lagrange shape functions and their derivatives on equally spaced nodes of [-1, 1].
-pub fn shape(nn: usize, xi: f64) -> ([f64; MAXN], [f64; MAXN]) {
-    let nodes: Vec<f64> = (0..nn)
-        .map(|k| -1.0 + 2.0 * k as f64 / (nn - 1) as f64)
-        .collect();
-    let mut n = [0.0; MAXN];
-    let mut dn = [0.0; MAXN];
-    for k in 0..nn {
-        let mut v = 1.0;
-        let mut d = 0.0;
-        for j in 0..nn {
-            if j == k {
-                continue;
-            }
-            let den = nodes[k] - nodes[j];
-            // Product rule: d/dxi of prod (xi - x_j) / den.
-            d = d * (xi - nodes[j]) / den + v / den;
-            v *= (xi - nodes[j]) / den;
-        }
-        n[k] = v;
-        dn[k] = d;
-    }
-    (n, dn)
 }
 
 /// The interpolated triad, curvature and their variation operators at one point.
@@ -188,7 +119,7 @@ impl BeamElement {
             nodes,
             triads,
             gravity,
-            load: [0.0; 3],
+            loads: Vec::new(),
             elastic: points(nn - 1),
             inertial: points(nn),
         };
@@ -344,8 +275,7 @@ impl BeamElement {
         }
         let (wn, dwn) = self.rates(st);
         let g = V3::from(self.gravity);
-        let load = V3::from(self.load);
-        for gp in &self.inertial {
+        for (gi, gp) in self.inertial.iter().enumerate() {
             let f = self.field(&rel, &x, gp, false);
             let (meta, rho) = Self::inertia(&f.t, gp);
             let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
@@ -353,8 +283,9 @@ impl BeamElement {
             let mass = gp.section.mass;
             let fu = mass * a + (dwt + wt * wt) * meta;
             let ft = meta.cross(&a) + rho * dw + w.cross(&(rho * w));
+            let (load, torque) = loads::at(&self.loads, gi, st.t, &f.t);
             let ext_u = mass * g + load;
-            let ext_t = meta.cross(&g);
+            let ext_t = meta.cross(&g) + torque;
             for k in 0..nn {
                 let d = &self.dofs[6 * k..6 * k + 6];
                 let c = gp.wj * gp.n[k];
@@ -416,11 +347,14 @@ impl BeamElement {
         }
         let (wn, dwn) = self.rates(st);
         let g = V3::from(self.gravity);
-        for gp in &self.inertial {
+        for (gi, gp) in self.inertial.iter().enumerate() {
             let f = self.field(&rel, &x, gp, true);
             let (meta, rho) = Self::inertia(&f.t, gp);
             let (a, w, dw) = self.point_rates(st, gp, &wn, &dwn);
             let (wt, dwt, at) = (tilde(&w), tilde(&dw), tilde(&a));
+            // Follower loads: d(T f*) = -(T f*)~ dtheta(xi), so the rows gain (T f*)~ A_l.
+            let (fu, ft) = loads::followers(&self.loads, gi, st.t, &f.t);
+            let (fu, ft) = (tilde(&fu), tilde(&ft));
             let et = tilde(&meta);
             let (rw, rdw) = (rho * w, rho * dw);
             let m_uu = M3::identity() * gp.section.mass;
@@ -439,9 +373,10 @@ impl BeamElement {
                         + k_ut * f.a[l] * (c.position * s);
                     add_block(kk, nl, r0, c0 + 3, &ut);
                     add_block(kk, nl, r0 + 3, c0, &(et * (c.mass * nl_ * s)));
+                    add_block(kk, nl, r0, c0 + 3, &(fu * f.a[l] * (cw * s)));
                     let tt = (rho * c.mass + g_tt * c.velocity) * (nl_ * s)
                         + k_tt * f.a[l] * (c.position * s)
-                        + k_grav * f.a[l] * (cw * s);
+                        + (k_grav + ft) * f.a[l] * (cw * s);
                     add_block(kk, nl, r0 + 3, c0 + 3, &tt);
                 }
             }
