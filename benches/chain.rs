@@ -32,7 +32,7 @@ fn runs(c: &mut Criterion) {
         match mbd::run(&compiled, &mut out) {
             Ok(r) => eprintln!(
                 "chain of {n}: {} unknowns, {} steps, {} Newton iterations",
-                compiled.lowered.as_ref().map_or(0, |l| l.system.len()),
+                compiled.lowered.system.len(),
                 r.stats.steps,
                 r.stats.newton_iterations
             ),

@@ -42,8 +42,8 @@ pub struct Compiled {
     pub model: Model,
     /// The solver settings: the `solve` block with the command line's request laid over it.
     pub settings: Settings,
-    /// The runtime system, or why this version cannot simulate the model (E0501).
-    pub lowered: Result<Lowered, Diagnostic>,
+    /// The runtime system.
+    pub lowered: Lowered,
     /// Warnings found while compiling.
     pub warnings: Vec<Diagnostic>,
 }
@@ -125,7 +125,8 @@ pub fn compile_with(
             })
         }
     };
-    let lowered = lower::lower(&model).map(|(system, provenance)| Lowered { system, provenance });
+    let (system, provenance) = lower::lower(&model);
+    let lowered = Lowered { system, provenance };
     Ok(Compiled {
         sources,
         ast,
@@ -196,9 +197,7 @@ impl Compiled {
             FailureKind::Interrupted => (Code::E0607, "run interrupted", "the run was stopped (Ctrl-C); the output keeps every row computed before it"),
             FailureKind::Unsupported => (Code::E0604, "integrator not available", "time finite elements integrate rotations incrementally: drop `--rotations conformal`, or use `--integrator hht` for the conformal treatment"),
         };
-        let Ok(l) = &self.lowered else {
-            return Diagnostic::error(code, what.to_string()).hint(hint);
-        };
+        let l = &self.lowered;
         let entity = f
             .entity
             .and_then(|e| l.system.entities.get(e).map(|x| (e, x)));
@@ -256,17 +255,7 @@ pub fn run_with_progress(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport, RunFailure> {
     let set = &c.settings;
-    let l = match &c.lowered {
-        Ok(l) => l,
-        Err(d) => {
-            return Err(RunFailure {
-                diagnostic: d.clone(),
-                failure: None,
-                warnings: Vec::new(),
-                rows: 0,
-            })
-        }
-    };
+    let l = &c.lowered;
     let sys = &l.system;
     let io_fail = |e: std::io::Error, rows| RunFailure {
         diagnostic: Diagnostic::error(Code::E0603, format!("cannot write the output: {e}"))
@@ -352,7 +341,7 @@ pub fn run_with_progress(
 /// increasing natural frequency. A state that is not a steady motion is refused (E0605), or
 /// with `frozen` gives the frozen-time eigenvalues, marked as such in [`solve::modes::Frame`].
 pub fn modes(c: &Compiled, frozen: bool) -> Result<solve::modes::Modes, Diagnostic> {
-    let l = c.lowered.as_ref().map_err(Clone::clone)?;
+    let l = &c.lowered;
     solve::modes::modes(&l.system, &c.settings, frozen).map_err(|f| match f {
         solve::modes::ModesFailure::Runtime(f) => c.failure_diagnostic(&f),
         solve::modes::ModesFailure::Unsteady(why) => c.unsteady_diagnostic(&why),
@@ -384,12 +373,12 @@ impl Compiled {
     pub fn unsteady_diagnostic(&self, why: &solve::modes::Unsteady) -> Diagnostic {
         use solve::modes::Unsteady;
         let entity = |e: usize| {
-            self.lowered.as_ref().ok().and_then(|l| {
-                let x = l.system.entities.get(e)?;
-                Some((
+            let l = &self.lowered;
+            l.system.entities.get(e).map(|x| {
+                (
                     format!("{} `{}`", x.kind, x.name),
                     l.provenance.spans.get(e).copied(),
-                ))
+                )
             })
         };
         let turn = |w: [f64; 3]| {
@@ -508,7 +497,7 @@ pub fn write_shapes(
     count: usize,
     out: &mut dyn Write,
 ) -> std::io::Result<()> {
-    let Ok(l) = &c.lowered else { return Ok(()) };
+    let l = &c.lowered;
     let sys = &l.system;
     writeln!(out, "mode,unknown,entity,kind,real,imag,frame")?;
     let frame = m.frame.label();

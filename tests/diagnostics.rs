@@ -83,7 +83,6 @@ const ELSEWHERE: &[Code] = &[
     Code::W0302,
     Code::E0208,
     Code::E0217,
-    Code::E0501,
     Code::E0601,
     Code::E0602,
     Code::E0603,
@@ -142,30 +141,6 @@ fn import_cycles_are_reported_and_user_modules_load() {
         Ok(c) => assert_eq!(c.model.bodies[0].name, "p.bob"),
         Err(f) => panic!("{}", render_all(&f.diagnostics, &f.sources)),
     }
-}
-
-#[test]
-fn a_valid_model_the_runtime_cannot_run_yet_says_so() {
-    // A joint between the nodes of an elastic beam: valid, but this runtime connects joints
-    // to beam nodes only.
-    let source = "model between \"A pin between beam nodes\"\n\
-section s { EA = 1e7 N, GA2 = 1e6 N, GA3 = 1e6 N, GJ = 1e3 N*m^2, EI2 = 1e3 N*m^2, EI3 = 1e3 N*m^2, mass_per_length = 1 kg/m }\n\
-ground earth\n\
-beam blade { from = (0, 0, 0) m, to = (2, 0, 0) m, section = s, elements = 2 }\n\
-joint pin = revolute(earth @ (0.3, 0, 0) m, blade.at(0.3 m)) { axis = z }\n\
-solve hht { dt = 1 ms, until = 1 s }\n";
-    let c = match mbd::compile("between.mbd", source, &[], Request::default()) {
-        Ok(c) => c,
-        Err(f) => panic!("{}", render_all(&f.diagnostics, &f.sources)),
-    };
-    let d = match &c.lowered {
-        Ok(_) => {
-            panic!("joints between beam nodes are not lowered yet; update this test when they are")
-        }
-        Err(d) => d.clone(),
-    };
-    assert_eq!(d.code, Code::E0501);
-    insta::assert_snapshot!("run_unsupported", render_all(&[d], &c.sources));
 }
 
 fn render_all(diags: &[Diagnostic], sources: &SourceMap) -> String {

@@ -44,6 +44,10 @@ fn linear(load: &dyn Fn(f64) -> String, q: f64, elements: usize, ga: f64) -> (f6
     (2.0 * y1 - y2 / 2.0, 2.0 * m1 - m2 / 2.0)
 }
 
+/// A load case: its name, its declaration for a load `q`, the tip's and the midspan's closed
+/// forms.
+type Case<'a> = (&'a str, &'a dyn Fn(f64) -> String, f64, f64);
+
 /// Uniform and triangular loads on the Euler-Bernoulli (GA = 1e12 N) and the Timoshenko
 /// (GA = 2,000 N: shear adds a fifth to the tip's deflection) cantilever, against the closed
 /// forms (L = 1 m, EI = 10 N*m^2): uniform `q`, tip `q L^4 / (8 EI) + q L^2 / (2 GA)`, midspan
@@ -59,7 +63,7 @@ fn a_loaded_cantilever_deflects_as_the_closed_forms_say() {
     let triangle =
         |q: f64| format!("distributed_force w on b = (0, {q} N/m * span / 1 m * t / 1 s, 0)");
     for (ga, model) in [(1e12, "Euler-Bernoulli"), (2000.0, "Timoshenko")] {
-        let cases: [(&str, &dyn Fn(f64) -> String, f64, f64); 2] = [
+        let cases: [Case; 2] = [
             (
                 "uniform",
                 &uniform,

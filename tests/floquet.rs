@@ -18,11 +18,7 @@ fn compiled(path: &str, sets: &[&str]) -> mbd::Compiled {
 
 /// Its runnable system.
 fn system(c: &mbd::Compiled) -> &mbd::runtime::System {
-    &c.lowered
-        .as_ref()
-        .map_err(|d| d.message.clone())
-        .unwrap()
-        .system
+    &c.lowered.system
 }
 
 fn both(path: &str, sets: &[&str], period: Option<f64>) -> (Floquet, Floquet) {
@@ -147,13 +143,7 @@ fn floquet_frequencies_are_the_blades_frequencies_of_the_multiblade_modes() {
             )
             .map_err(|f| format!("{:?}", f.diagnostics))
             .unwrap();
-            let sys = c
-                .lowered
-                .as_ref()
-                .map_err(|d| d.message.clone())
-                .unwrap()
-                .system
-                .clone();
+            let sys = c.lowered.system.clone();
             (c, sys)
         };
         let period = mbd::study::sweep::rotor_period(&c).unwrap();

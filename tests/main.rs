@@ -3,6 +3,7 @@
 mod architecture;
 mod beam_order;
 mod beams;
+mod between;
 mod campbell;
 mod charts;
 mod cli;

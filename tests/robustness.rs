@@ -263,8 +263,8 @@ fn run_limited(
 
 /// Mutants through the binary, each under a wall-clock limit: `mbd check` exits 0 or 1 within
 /// 10 s, and a model that checks runs 3 steps (`--steps 3`: the whole run in three large steps)
-/// and exits 0, 1 (an error only lowering finds, such as E0501) or 3 (a run-time failure,
-/// reported) within 30 s: never a panic (101), a signal, or a hang.
+/// and exits 0, 1 (an error found as the run starts) or 3 (a run-time failure, reported)
+/// within 30 s: never a panic (101), a signal, or a hang.
 #[test]
 fn mutated_models_exit_zero_or_one_and_run_or_fail_cleanly() {
     use std::ffi::OsStr;

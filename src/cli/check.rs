@@ -47,13 +47,7 @@ pub fn check(a: CheckArgs) -> ExitCode {
         Some(Emit::Ast) => json(serde_json::to_string_pretty(&c.ast)),
         Some(Emit::Model) => json(serde_json::to_string_pretty(&c.model)),
         Some(Emit::Dofs) => json(serde_json::to_string_pretty(&c.model.dofs)),
-        Some(Emit::Ir) => match &c.lowered {
-            Ok(l) => json(serde_json::to_string_pretty(&l.system)),
-            Err(d) => {
-                report(std::slice::from_ref(d), &c.sources, format);
-                return ExitCode::from(EXIT_MODEL);
-            }
-        },
+        Some(Emit::Ir) => json(serde_json::to_string_pretty(&c.lowered.system)),
         None => summary(&c, format),
     };
     say(&out);
@@ -66,30 +60,22 @@ fn summary(c: &mbd::Compiled, format: Format) -> String {
     let mult = m.dofs.multipliers();
     let nodes = m.bodies.len() + m.beams.iter().map(|b| b.nodes.len()).sum::<usize>();
     let columns: Vec<&str> = m.outputs.iter().map(|o| o.column.as_str()).collect();
-    let nonzeros = c
-        .lowered
-        .as_ref()
-        .ok()
-        .map(|l| mbd::runtime::Pattern::of(n, &l.system.elements).nnz());
+    let nonzeros = mbd::runtime::Pattern::of(n, &c.lowered.system.elements).nnz();
     if format == Format::Json {
         return serde_json::json!({
             "model": m.name, "bodies": m.bodies.len(), "beams": m.beams.len(), "nodes": nodes,
             "joints": m.joints.len(), "dofs": n - mult - m.dofs.extras(), "extra_unknowns": m.dofs.extras(),
             "multipliers": mult, "unknowns": n, "bandwidth": m.dofs.bandwidth, "nonzeros": nonzeros,
             "channels": columns, "steps": c.settings.steps, "dt": c.settings.dt, "until": c.settings.until,
-            "runnable": c.lowered.is_ok(),
+            "runnable": true,
         })
         .to_string();
     }
-    let runnable = match &c.lowered {
-        Ok(_) => String::new(),
-        Err(d) => format!("\n  note: {}", d.message),
-    };
     format!(
-        "model {}: ok\n{}\n  nonzeros     {}\n  outputs      {}\n  solve        {} steps of {} s to {} s{runnable}",
+        "model {}: ok\n{}\n  nonzeros     {}\n  outputs      {}\n  solve        {} steps of {} s to {} s",
         m.name,
         mbd::model::topology::report(m),
-        nonzeros.map(|x| x.to_string()).unwrap_or_else(|| "-".to_string()),
+        nonzeros,
         std::iter::once("t").chain(columns.iter().copied()).collect::<Vec<_>>().join(", "),
         c.settings.steps,
         c.settings.dt,

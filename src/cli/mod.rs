@@ -109,15 +109,6 @@ pub fn compile(
     }
 }
 
-/// The compiled model, if it is runnable; else its lowering error is reported: exit code 1.
-pub fn runnable(c: Compiled, format: Format) -> Result<Compiled, ExitCode> {
-    if let Err(d) = &c.lowered {
-        report(std::slice::from_ref(d), &c.sources, format);
-        return Err(ExitCode::from(EXIT_MODEL));
-    }
-    Ok(c)
-}
-
 /// The model of a study or a sweep, compiled again by each job in its worker thread: silently,
 /// a failure kept as its first error.
 pub struct Jobs<'a> {

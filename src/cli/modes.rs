@@ -5,7 +5,7 @@ use super::progress::Evaluations;
 use super::swept::Swept;
 use super::{
     compile, create_outputs, draw_panels, exit_unless_failed, read_as, report, sink, to_path,
-    usage, Format, Jobs, EXIT_MODEL, EXIT_RUNTIME,
+    usage, Format, Jobs, EXIT_RUNTIME,
 };
 use mbd::settings::Request;
 use mbd::solve::modes::{Frame, Modes};
@@ -99,11 +99,7 @@ fn at_start(a: &ModesArgs, text: &str) -> ExitCode {
         Ok(m) => m,
         Err(d) => {
             report(std::slice::from_ref(&d), &c.sources, a.format);
-            return ExitCode::from(if c.lowered.is_err() {
-                EXIT_MODEL
-            } else {
-                EXIT_RUNTIME
-            });
+            return ExitCode::from(EXIT_RUNTIME);
         }
     };
     let mut table = match sink(a.output.as_deref()) {

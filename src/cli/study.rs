@@ -3,8 +3,7 @@
 //! itself (runs, errors, orders, onsets) lives in the library.
 
 use super::{
-    compile, create_outputs, draw, read, runnable, say, short, usage, ChartFile, Format, Jobs,
-    EXIT_RUNTIME,
+    compile, create_outputs, draw, read, say, short, usage, ChartFile, Format, Jobs, EXIT_RUNTIME,
 };
 use mbd::settings::Request;
 use mbd::study::compare::Samples;
@@ -115,9 +114,7 @@ pub fn study(a: StudyArgs) -> ExitCode {
         until: a.until,
         ..Request::default()
     };
-    let c = match compile(&a.model, &text, &a.set, base.clone(), Format::Human)
-        .and_then(|c| runnable(c, Format::Human))
-    {
+    let c = match compile(&a.model, &text, &a.set, base.clone(), Format::Human) {
         Ok(c) => c,
         Err(code) => return code,
     };

@@ -1,7 +1,7 @@
 //! `--sweep NAME=START:STOP:STEP` of `mbd modes` and `mbd stability`: the param, its values,
 //! and the model compiled at the first value.
 
-use super::{compile, runnable, usage, Format, FsLoader};
+use super::{compile, usage, Format, FsLoader};
 use mbd::settings::Request;
 use mbd::study::sweep::{self, RangeError};
 use mbd::study::CompileError;
@@ -58,10 +58,7 @@ impl Swept {
     ) -> Result<Compiled, ExitCode> {
         let mut first = sets.to_vec();
         first.push(format!("{}={}", self.param, self.values[0]));
-        let c = runnable(
-            compile(path, text, &first, Request::default(), format)?,
-            format,
-        )?;
+        let c = compile(path, text, &first, Request::default(), format)?;
         if !c.model.params.iter().any(|(n, _)| *n == self.param) {
             let known: Vec<&str> = c.model.params.iter().map(|(n, _)| n.as_str()).collect();
             return Err(usage(&format!(

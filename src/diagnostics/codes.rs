@@ -236,9 +236,6 @@ of the time `t`, params and time functions (`ramp`, `step`, `sine`, `piecewise`,
 with the channel's dimension. A vector, a rotation or a reference to a body is not the value of \
 one channel; write the component that channel outputs, e.g. `exact x = L * sin(w * t)` for \
 `output x = bob.position.x`.";
-    E0501 = "E0501", "not supported by this runtime",
-        "The model is valid, but this version of the runtime cannot simulate one of its elements \
-yet. `mbd check` accepts it; `mbd run` will once the runtime supports the element.";
     E0601 = "E0601", "Newton iteration failed",
         "The nonlinear equations of a time step did not converge, even after the step was halved \
 three times. The report names the time, the step and the element with the largest residual. \

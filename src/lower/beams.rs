@@ -3,12 +3,13 @@
 
 use super::Lower;
 use crate::model::{Beam, Section};
-use crate::runtime::beams::{inertial_points, Distributed, SectionAt};
+use crate::runtime::beams::{inertial_points, triad_between, Distributed, SectionAt};
 use crate::runtime::rotation::{M3, V3};
 use crate::runtime::LoadKind;
 use crate::runtime::{
     arr3, m3, BeamElement, Element, NodeRotation, Probe, ProbeQuantity, RigidBody, State,
 };
+use crate::runtime::{Between, End};
 
 /// A section's properties for the element, in the section frame: its stiffness, `m`, `eta*`
 /// and the inertia per length about the reference line (the section gives it about its centre
@@ -125,9 +126,7 @@ pub fn between_nodes(
     component: usize,
 ) -> Probe {
     let b = &lw.model.beams[bi];
-    let le = b.length / b.elements as f64;
-    let e = ((s / le).floor() as usize).min(b.elements - 1);
-    let xi = 2.0 * (s - e as f64 * le) / le - 1.0;
+    let (e, xi) = locate(b, s);
     let p = b.order;
     let (n, _) = crate::runtime::beams::shape(p, xi);
     let mut dofs = Vec::new();
@@ -143,4 +142,39 @@ pub fn between_nodes(
         quantity,
         component,
     }
+}
+
+/// The element of beam `b` holding arc length `s`, and the point's coordinate on [-1, 1].
+pub fn locate(b: &Beam, s: f64) -> (usize, f64) {
+    let le = b.length / b.elements as f64;
+    let e = ((s / le).floor().max(0.0) as usize).min(b.elements - 1);
+    (e, 2.0 * (s - e as f64 * le) / le - 1.0)
+}
+
+/// A marker at arc length `s` between the nodes of beam `bi`, at `position` with `axes`
+/// (inertial, t = 0): its offset and axes are kept in the element's interpolated triad there.
+pub fn end_between(lw: &Lower, bi: usize, s: f64, position: V3, axes: &M3) -> End {
+    let b = &lw.model.beams[bi];
+    let (e, xi) = locate(b, s);
+    let p = b.order;
+    let (n, _) = crate::runtime::beams::shape(p, xi);
+    let local: Vec<usize> = (e * (p - 1)..e * (p - 1) + p).collect();
+    let starts = &lw.model.dofs.node_start[bi];
+    let frames: Vec<M3> = local.iter().map(|&k| m3(&b.frames[k])).collect();
+    let (t0, _) = triad_between(&frames, &n);
+    let mut x0 = V3::zeros();
+    for (j, &k) in local.iter().enumerate() {
+        x0 += V3::from(b.initial_nodes[k]) * n[j];
+    }
+    End::Between(Box::new(Between {
+        dofs: local
+            .iter()
+            .flat_map(|&k| starts[k]..starts[k] + 6)
+            .collect(),
+        nodes: local.iter().map(|&k| lw.beam_nodes[bi][k]).collect(),
+        triads: local.iter().map(|&k| b.frames[k]).collect(),
+        n,
+        offset: (t0.transpose() * (position - x0)).into(),
+        axes: arr3(&(t0.transpose() * axes)),
+    }))
 }

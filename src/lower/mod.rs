@@ -2,13 +2,11 @@
 //!
 //! Contract: assigns global indices from the model's DOF map, turns bodies, joints, springs
 //! and loads into elements and outputs into probes, and records for every runtime entity the
-//! span it came from. Raises no user errors (the model stage has caught them), except E0501
-//! for what this version's runtime cannot simulate (beams).
+//! span it came from. Raises no user errors: the model stage has caught them.
 
 mod beams;
 mod joints;
 
-use crate::diagnostics::{Code, Diagnostic};
 use crate::model::dofs::Unknown;
 use crate::model::{
     Attach, Body, BodyKind, BodyQuantity, EnergyKind as ModelEnergy, JointQuantity, Marker, Model,
@@ -25,39 +23,6 @@ use crate::source::Span;
 #[derive(Clone, Debug, Default)]
 pub struct Provenance {
     pub spans: Vec<Span>,
-}
-
-/// What this version's runtime cannot simulate yet, if anything (E0501, with a span): a joint,
-/// spring or load at a point between the nodes of an elastic beam.
-fn unsupported(model: &Model) -> Option<Diagnostic> {
-    let between = |m: &Marker| match m.attach {
-        Attach::BeamPoint { beam, s } => Some((beam, s)),
-        _ => None,
-    };
-    let markers = model
-        .joints
-        .iter()
-        .flat_map(|j| j.markers.iter())
-        .chain(model.springs.iter().flat_map(|s| s.markers.iter()))
-        .chain(model.loads.iter().map(|l| &l.marker));
-    for m in markers {
-        if let Some((beam, s)) = between(m) {
-            let b = &model.beams[beam];
-            let h = b.length / (b.nodes.len() - 1) as f64;
-            return Some(
-                Diagnostic::error(
-                    Code::E0501,
-                    format!("`{}` is between two nodes of beam `{}`: this version connects joints, springs and loads to beam nodes only", m.text, b.name),
-                )
-                .at(m.span, "between nodes")
-                .hint(format!(
-                    "nodes of `{}` are every {h} m; choose `elements` and `order` so that a node falls at s = {s} m, and name it `node[k]`",
-                    b.name
-                )),
-            );
-        }
-    }
-    None
 }
 
 /// The lowering context: the model and the index maps.
@@ -112,9 +77,10 @@ impl Lower<'_> {
                     axes,
                 }
             }
-            // Grounds, and points between beam nodes (rejected before, except for outputs,
-            // which lower them separately).
-            _ => End::Ground {
+            Attach::BeamPoint { beam, s } => {
+                beams::end_between(self, beam, s, position, &m3(&axes))
+            }
+            Attach::Ground { .. } => End::Ground {
                 point: position.into(),
                 axes,
             },
@@ -201,10 +167,7 @@ fn entities(model: &Model) -> (Vec<Entity>, Vec<Span>) {
     (entities, spans)
 }
 
-pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
-    if let Some(d) = unsupported(model) {
-        return Err(d);
-    }
+pub fn lower(model: &Model) -> (System, Provenance) {
     let n = model.dofs.len();
     let nodes = nodes(model);
     let rotations_len = nodes.rotations.len();
@@ -263,7 +226,7 @@ pub fn lower(model: &Model) -> Result<(System, Provenance), Diagnostic> {
         channels,
         length_scale: length_scale(model),
     };
-    Ok((system, Provenance { spans }))
+    (system, Provenance { spans })
 }
 
 impl Lower<'_> {

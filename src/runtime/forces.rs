@@ -7,7 +7,7 @@
 //! the relative rotation vector of two markers' axes. A [`Load`] is a force or torque at a
 //! marker, fixed in space or following the marker's axes.
 
-use super::joints::{dot13, globals, slots, End, Geo, Row, SLOTS};
+use super::joints::{dot13, globals, slots, End, Geo, Grad, Hess, Row, Spreads, SLOTS};
 use super::rotation::{left_jacobian_inverse, log, tilde, M3, V3};
 use super::timefn::TimeFn;
 use super::{Energy, Residual, State, TangentCoeffs};
@@ -56,6 +56,9 @@ impl Spring {
     }
 
     pub fn residual(&self, st: &State, r: &mut Residual) {
+        if self.a.is_between() || self.b.is_between() {
+            return self.residual_between(st, r);
+        }
         let geo = Geo::new(&self.a, &self.b, self.angle, st);
         let glob = globals(&self.a, &self.b, self.angle);
         match self.kind {
@@ -81,6 +84,57 @@ impl Spring {
         }
     }
 
+    /// The residual with an end between beam nodes: the slot forces through `Spreads`.
+    fn residual_between(&self, st: &State, r: &mut Residual) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        // The generalized force on the slots.
+        let mut force = [0.0; SLOTS];
+        match self.kind {
+            SpringKind::Row => {
+                let (f, gr) = self.row_force(st, &geo);
+                force.iter_mut().zip(&gr).for_each(|(x, g)| *x = f * g);
+            }
+            SpringKind::Torsional => {
+                let m = self.torsion(&geo).1;
+                for k in 0..3 {
+                    force[3 + k] = -m[k];
+                    force[9 + k] = m[k];
+                }
+            }
+        }
+        let sp = Spreads::new(&self.a, &self.b, self.angle, st);
+        sp.add_forces(&force, (&self.a, &self.b, self.angle), &mut r.force);
+    }
+
+    /// A row spring's gradient, the derivative of its force through the positions,
+    /// `d f / d q_j = k g_j c_q + c c_q (V^T H1)_j` (the damper's `c c_v g_j` apart), and its
+    /// geometric stiffness `f H` added to `h`.
+    fn row_parts(&self, st: &State, geo: &Geo, c: TangentCoeffs, h: &mut Hess) -> (Grad, Grad) {
+        let (f, gr) = self.row_force(st, geo);
+        self.row.hess(geo, f, h);
+        let mut h1 = [[0.0; SLOTS]; SLOTS];
+        if self.damping != 0.0 {
+            self.row.hess(geo, 1.0, &mut h1);
+        }
+        let mut df = [0.0; SLOTS];
+        for (j, d) in df.iter_mut().enumerate() {
+            let vh: f64 = (0..SLOTS).map(|i| geo.vel[i] * h1[i][j]).sum();
+            *d = self.stiffness * gr[j] * c.position + self.damping * c.position * vh;
+        }
+        (gr, df)
+    }
+
+    /// A torsional spring's moment derivatives: `k dpsi/dtheta_A`, `k dpsi/dtheta_B` (times
+    /// `c_q`) and the damper's `c c_v I`.
+    fn torsion_parts(&self, geo: &Geo, c: TangentCoeffs) -> (M3, M3, M3) {
+        let (psi, _, rrel) = self.torsion(geo);
+        let jinv = left_jacobian_inverse(&psi);
+        // d psi / d theta_B = J^-1, d psi / d theta_A = -J^-1 R_rel.
+        let dpsi_b = jinv * self.stiffness * c.position;
+        let dpsi_a = -jinv * rrel * self.stiffness * c.position;
+        (dpsi_a, dpsi_b, M3::identity() * (self.damping * c.velocity))
+    }
+
     /// Relative rotation `psi`, the moment `k psi + c (w_B - w_A)` and `R_rel = E_B E_A^T`.
     fn torsion(&self, geo: &Geo) -> (V3, V3, M3) {
         let rrel = geo.b.e * geo.a.e.transpose();
@@ -90,6 +144,9 @@ impl Spring {
     }
 
     pub fn tangent(&self, st: &State, c: TangentCoeffs, k: &mut [f64]) {
+        if self.a.is_between() || self.b.is_between() {
+            return self.tangent_between(st, c, k);
+        }
         let geo = Geo::new(&self.a, &self.b, self.angle, st);
         let (map, nl) = slots(&self.a, &self.b, self.angle);
         k[..nl * nl].iter_mut().for_each(|x| *x = 0.0);
@@ -97,18 +154,9 @@ impl Spring {
         let mut h = [[0.0; SLOTS]; SLOTS];
         match self.kind {
             SpringKind::Row => {
-                let (f, gr) = self.row_force(st, &geo);
-                self.row.hess(&geo, f, &mut h);
-                let mut h1 = [[0.0; SLOTS]; SLOTS];
-                if self.damping != 0.0 {
-                    self.row.hess(&geo, 1.0, &mut h1);
-                }
-                // d f / d q_j = k g_j c_q + c (c_v g_j + c_q (V^T H1)_j).
-                let mut df = [0.0; SLOTS];
-                for (j, d) in df.iter_mut().enumerate() {
-                    let vh: f64 = (0..SLOTS).map(|i| geo.vel[i] * h1[i][j]).sum();
-                    *d = self.stiffness * gr[j] * c.position
-                        + self.damping * (c.velocity * gr[j] + c.position * vh);
+                let (gr, mut df) = self.row_parts(st, &geo, c, &mut h);
+                for (d, g) in df.iter_mut().zip(&gr) {
+                    *d += self.damping * c.velocity * g;
                 }
                 for (si, li) in map.iter().enumerate() {
                     let Some(li) = li else { continue };
@@ -120,12 +168,7 @@ impl Spring {
                 }
             }
             SpringKind::Torsional => {
-                let (psi, _, rrel) = self.torsion(&geo);
-                let jinv = left_jacobian_inverse(&psi);
-                // d psi / d theta_B = J^-1, d psi / d theta_A = -J^-1 R_rel.
-                let dpsi_b = jinv * self.stiffness * c.position;
-                let dpsi_a = -jinv * rrel * self.stiffness * c.position;
-                let dw = M3::identity() * (self.damping * c.velocity);
+                let (dpsi_a, dpsi_b, dw) = self.torsion_parts(&geo, c);
                 let by_a = dpsi_a - dw;
                 let by_b = dpsi_b + dw;
                 // Moment m on theta_B (+) and theta_A (-).
@@ -143,6 +186,47 @@ impl Spring {
                 }
             }
         }
+    }
+
+    /// The tangent with an end between beam nodes: the slot matrices through `Spreads`, the
+    /// part from the velocities through their interpolation.
+    fn tangent_between(&self, st: &State, c: TangentCoeffs, k: &mut [f64]) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        let (_, nl) = slots(&self.a, &self.b, self.angle);
+        k[..nl * nl].iter_mut().for_each(|x| *x = 0.0);
+        // The derivative of the slot forces over the slots, through the positions (`hs`) and
+        // the velocities (`hv`).
+        let mut hs = [[0.0; SLOTS]; SLOTS];
+        let mut hv = [[0.0; SLOTS]; SLOTS];
+        match self.kind {
+            SpringKind::Row => {
+                let mut h = [[0.0; SLOTS]; SLOTS];
+                let (gr, df) = self.row_parts(st, &geo, c, &mut h);
+                for si in 0..SLOTS {
+                    for sj in 0..SLOTS {
+                        hs[si][sj] = gr[si] * df[sj] + c.position * h[si][sj];
+                        hv[si][sj] = gr[si] * self.damping * c.velocity * gr[sj];
+                    }
+                }
+            }
+            SpringKind::Torsional => {
+                let (dpsi_a, dpsi_b, dw) = self.torsion_parts(&geo, c);
+                // Moment m on theta_B (+) and theta_A (-).
+                for (rs, sign) in [(9usize, 1.0), (3usize, -1.0)] {
+                    for (cs, blk, rate) in [(3usize, &dpsi_a, -dw), (9usize, &dpsi_b, dw)] {
+                        for i in 0..3 {
+                            for j in 0..3 {
+                                hs[rs + i][cs + j] = sign * blk[(i, j)];
+                                hv[rs + i][cs + j] = sign * rate[(i, j)];
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        let sp = Spreads::new(&self.a, &self.b, self.angle, st);
+        sp.add_matrix(&hs, c.force_weight, false, k, nl);
+        sp.add_matrix(&hv, c.force_weight, true, k, nl);
     }
 
     pub fn energy(&self, st: &State) -> Energy {
@@ -198,22 +282,24 @@ impl Load {
         }
         let kin = self.end.kin(st);
         let v = self.value(st, &kin.e);
-        match self.kind {
-            LoadKind::Force => {
-                let m = kin.p.cross(&v);
-                for k in 0..3 {
-                    r.force[d[k]] -= v[k];
-                    if d.len() == 6 {
-                        r.force[d[3 + k]] -= m[k];
-                    }
-                }
-            }
-            LoadKind::Torque => {
-                if d.len() == 6 {
-                    for k in 0..3 {
-                        r.force[d[3 + k]] -= v[k];
-                    }
-                }
+        // Minus the force and the moment about the end's node (its reference point).
+        let (f, m) = match self.kind {
+            LoadKind::Force => (-v, -kin.p.cross(&v)),
+            LoadKind::Torque => (V3::zeros(), -v),
+        };
+        if self.end.is_between() {
+            let mut force = [0.0; SLOTS];
+            force[..3].copy_from_slice(f.as_slice());
+            force[3..6].copy_from_slice(m.as_slice());
+            let ground = End::ground();
+            let sp = Spreads::new(&self.end, &ground, None, st);
+            sp.add_forces(&force, (&self.end, &ground, None), &mut r.force);
+            return;
+        }
+        for k in 0..3 {
+            r.force[d[k]] += f[k];
+            if d.len() == 6 {
+                r.force[d[3 + k]] += m[k];
             }
         }
     }
@@ -221,7 +307,7 @@ impl Load {
     pub fn tangent(&self, st: &State, c: TangentCoeffs, k: &mut [f64]) {
         let n = self.end.dofs().len();
         k[..n * n].iter_mut().for_each(|x| *x = 0.0);
-        if n != 6 {
+        if n < 6 {
             return;
         }
         let kin = self.end.kin(st);
@@ -234,6 +320,18 @@ impl Load {
             (LoadKind::Torque, false) => (M3::zeros(), M3::zeros()),
             (LoadKind::Torque, true) => (M3::zeros(), vt),
         };
+        if self.end.is_between() {
+            let mut hs = [[0.0; SLOTS]; SLOTS];
+            for i in 0..3 {
+                for j in 0..3 {
+                    hs[i][3 + j] = ut[(i, j)];
+                    hs[3 + i][3 + j] = tt[(i, j)];
+                }
+            }
+            let ground = End::ground();
+            Spreads::new(&self.end, &ground, None, st).add_matrix(&hs, s, false, k, n);
+            return;
+        }
         for i in 0..3 {
             for j in 0..3 {
                 k[i * 6 + 3 + j] += s * ut[(i, j)];

@@ -25,7 +25,7 @@ pub use beams::BeamElement;
 pub use bodies::{PointMass, RigidBody};
 pub use elements::Element;
 pub use forces::{Load, LoadKind, Spring, SpringKind};
-pub use joints::{End, EndKin, Joint, Row};
+pub use joints::{Between, End, EndKin, Joint, Row};
 pub use probes::{Coleman, EnergyKind, MassMoments, Probe, ProbeQuantity};
 
 use rotation::{M3, V3};

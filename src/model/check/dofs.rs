@@ -76,22 +76,21 @@ fn node_index(model: &Model) -> (Vec<Node>, impl Fn(Node) -> usize + '_) {
     (nodes, index)
 }
 
-/// The nodes an attachment moves with (a point between beam nodes moves with both).
+/// The nodes an attachment moves with (a point between beam nodes moves with its element's).
 pub fn attach_nodes(model: &Model, a: &Attach) -> Vec<Node> {
     match *a {
         Attach::Ground { .. } => Vec::new(),
         Attach::Body { body } => vec![Node::Body { body }],
         Attach::BeamNode { beam, node } => vec![Node::BeamNode { beam, node }],
         Attach::BeamPoint { beam, s } => {
+            // Every node of the element holding the point.
             let b = &model.beams[beam];
-            let n = b.nodes.len();
-            let k = ((s / b.length) * (n - 1) as f64)
-                .floor()
-                .clamp(0.0, (n - 2) as f64) as usize;
-            vec![
-                Node::BeamNode { beam, node: k },
-                Node::BeamNode { beam, node: k + 1 },
-            ]
+            let le = b.length / b.elements as f64;
+            let e = ((s / le).floor().max(0.0) as usize).min(b.elements - 1);
+            let first = e * (b.order - 1);
+            (first..first + b.order)
+                .map(|node| Node::BeamNode { beam, node })
+                .collect()
         }
     }
 }

@@ -17,20 +17,21 @@
 //! converges quadratically and the finite-difference oracle agrees to round-off.
 
 use super::bodies::add_block;
-use super::rotation::{
-    from_matrix, rotation, tangent, tangent_inverse, tangent_rate, tilde, M3, V3,
-};
+use super::rotation::{rotation, tangent, tangent_rate, tilde, M3, V3};
 use super::{m3, Energy, MassMoments, Residual, State, TangentCoeffs};
 use serde::{Deserialize, Serialize};
 
+mod frame;
 mod loads;
 mod quadrature;
+pub(crate) use frame::triad_between;
+use frame::{relative, Relative};
 pub use loads::Distributed;
 use quadrature::gauss;
 pub use quadrature::{inertial_points, shape, Gauss, SectionAt};
 
 /// Most nodes of an element.
-const MAXN: usize = 4;
+pub(crate) const MAXN: usize = 4;
 
 /// A beam element.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -60,16 +61,6 @@ struct Field {
     /// `dtheta(xi) = sum a[l] dtheta_l`, `dtheta'(xi) = sum da[l] dtheta_l`.
     a: [M3; MAXN],
     da: [M3; MAXN],
-}
-
-/// Per-element quantities shared by all points: the reference triad, relative parameters and
-/// their inverse tangents.
-struct Relative {
-    r: usize,
-    tr: M3,
-    p: [V3; MAXN],
-    /// `H(p_k)^-1 T_r^T`.
-    g: [M3; MAXN],
 }
 
 impl BeamElement {
@@ -126,30 +117,13 @@ impl BeamElement {
         // Reference strains: the same measure in the reference configuration.
         let x: Vec<V3> = positions.iter().map(|p| V3::from(*p)).collect();
         let t: Vec<M3> = e.triads.iter().map(m3).collect();
-        let rel = e.relative_from(&t);
+        let rel = relative(&t[..e.len()]);
         for gi in 0..e.elastic.len() {
             let f = e.field(&rel, &x, &e.elastic[gi], false);
             let (g, k) = (f.t.transpose() * f.dx - V3::x(), f.t.transpose() * f.k);
             e.elastic[gi].strain0 = [g[0], g[1], g[2], k[0], k[1], k[2]];
         }
         e
-    }
-
-    fn relative_from(&self, t: &[M3]) -> Relative {
-        let nn = self.len();
-        let r = nn / 2;
-        let tr = t[r];
-        let mut p = [V3::zeros(); MAXN];
-        let mut g = [M3::zeros(); MAXN];
-        for k in 0..nn {
-            p[k] = if k == r {
-                V3::zeros()
-            } else {
-                from_matrix(&(tr.transpose() * t[k]))
-            };
-            g[k] = tangent_inverse(&p[k]) * tr.transpose();
-        }
-        Relative { r, tr, p, g }
     }
 
     fn triads_at(&self, st: &State) -> [M3; MAXN] {
@@ -260,7 +234,7 @@ impl BeamElement {
         let nn = self.len();
         let x = self.positions(&st.q);
         let t = self.triads_at(st);
-        let rel = self.relative_from(&t);
+        let rel = relative(&t[..nn]);
         for gp in &self.elastic {
             let f = self.field(&rel, &x, gp, false);
             let (fo, mo, _) = self.resultants(&f, gp);
@@ -307,7 +281,7 @@ impl BeamElement {
         kk[..nl * nl].iter_mut().for_each(|v| *v = 0.0);
         let x = self.positions(&st.q);
         let t = self.triads_at(st);
-        let rel = self.relative_from(&t);
+        let rel = relative(&t[..nn]);
         let cw = c.position * c.force_weight;
         for gp in &self.elastic {
             let f = self.field(&rel, &x, gp, true);
@@ -391,7 +365,7 @@ impl BeamElement {
         let x = self.positions(&st.q);
         let vn = self.positions(&st.v);
         let t = self.triads_at(st);
-        let rel = self.relative_from(&t);
+        let rel = relative(&t[..nn]);
         let (wn, _) = self.rates(st);
         for gp in &self.inertial {
             let f = self.field(&rel, &x, gp, false);
@@ -421,7 +395,7 @@ impl BeamElement {
         let nn = self.len();
         let x = self.positions(&st.q);
         let t = self.triads_at(st);
-        let rel = self.relative_from(&t);
+        let rel = relative(&t[..nn]);
         let mut e = Energy::default();
         for gp in &self.elastic {
             let f = self.field(&rel, &x, gp, false);
@@ -463,7 +437,7 @@ impl BeamElement {
         let nn = self.len();
         let x = self.positions(&st.q);
         let t = self.triads_at(st);
-        let rel = self.relative_from(&t);
+        let rel = relative(&t[..nn]);
         let (wn, dwn) = self.rates(st);
         let mut out = MassMoments::default();
         for gp in &self.inertial {

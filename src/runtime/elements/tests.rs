@@ -71,9 +71,27 @@ fn node_end(rng: &mut Lcg, which: usize) -> End {
     }
 }
 
+/// Every fourth case: end B between the nodes of a two-node beam element over nodes A and B
+/// (their triads at t = 0 close to each other, as the state's rotations are made too), end A
+/// on the ground.
 fn ends(rng: &mut Lcg, case: usize) -> (End, End) {
-    let b = node_end(rng, 1);
-    let a = match case % 3 {
+    let b = if case % 4 == 3 {
+        let common = crate::runtime::m3(&rng.rotation(3.0));
+        let triads = (0..2)
+            .map(|_| crate::runtime::arr3(&(crate::runtime::m3(&rng.rotation(0.2)) * common)))
+            .collect();
+        End::Between(Box::new(super::super::joints::Between {
+            dofs: (0..12).collect(),
+            nodes: vec![0, 1],
+            triads,
+            n: [0.35, 0.65, 0.0, 0.0],
+            offset: rng.v3(),
+            axes: rng.rotation(3.0),
+        }))
+    } else {
+        node_end(rng, 1)
+    };
+    let a = match case % 4 {
         0 => node_end(rng, 0),
         1 => End::Point {
             dofs: [0, 1, 2],
@@ -241,7 +259,12 @@ fn tangents_match_central_differences() {
             p: 1.0 + 3.0 * rng.next().abs(),
             rate_scale: 1.0 / c.velocity,
         };
-        let st = random_state(&mut rng);
+        let mut st = random_state(&mut rng);
+        if case % 4 == 3 {
+            // The element's two nodes turned alike, up to 0.3 rad.
+            let r = crate::runtime::m3(&rng.rotation(0.3)) * st.rot[0].matrix();
+            st.rot[1].set_matrix(&r);
+        }
         for (ei, el) in elements(&mut rng, case).iter().enumerate() {
             let idx = el.indices();
             let nl = idx.len();

@@ -26,8 +26,8 @@ pub(crate) type Grad = [f64; SLOTS];
 pub(crate) type Hess = [[f64; SLOTS]; SLOTS];
 
 mod ends;
-pub(crate) use ends::Geo;
-pub use ends::{End, EndKin};
+pub use ends::{Between, End, EndKin};
+pub(crate) use ends::{Geo, Spreads};
 
 /// A primitive constraint row. Axis indices are 0-based (`a_0` is the marker's first axis).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -335,20 +335,13 @@ impl Joint {
     }
 
     pub fn residual(&self, st: &State, aug: Augment, r: &mut Residual) {
+        if self.a.is_between() || self.b.is_between() {
+            return self.residual_between(st, aug, r);
+        }
         let geo = Geo::new(&self.a, &self.b, self.angle, st);
         let glob = globals(&self.a, &self.b, self.angle);
         for (k, row) in self.rows.iter().enumerate() {
-            let m = self.first + k;
-            let (gv, gr) = row.geom(&geo);
-            let f = row.drive().map_or(0.0, |f| f.eval(st.t));
-            let mu = if row.is_rate() {
-                r.constraint[m] = aug.rate_scale * (dot13(&gr, &geo.vel) - f);
-                aug.s * st.lambda[m]
-            } else {
-                let c = gv - f;
-                r.constraint[m] = c;
-                aug.s * st.lambda[m] + aug.p * c
-            };
+            let (mu, gr) = self.row_residual(k, row, &geo, st, aug, r);
             for (s, gi) in glob.iter().enumerate() {
                 if let Some(i) = gi {
                     r.force[*i] += mu * gr[s];
@@ -357,13 +350,55 @@ impl Joint {
         }
     }
 
+    /// Row `k`'s equation into `r.constraint`, and its force `mu` with its gradient.
+    #[inline(always)]
+    fn row_residual(
+        &self,
+        k: usize,
+        row: &Row,
+        geo: &Geo,
+        st: &State,
+        aug: Augment,
+        r: &mut Residual,
+    ) -> (f64, Grad) {
+        let m = self.first + k;
+        let (gv, gr) = row.geom(geo);
+        let f = row.drive().map_or(0.0, |f| f.eval(st.t));
+        let mu = if row.is_rate() {
+            r.constraint[m] = aug.rate_scale * (dot13(&gr, &geo.vel) - f);
+            aug.s * st.lambda[m]
+        } else {
+            let c = gv - f;
+            r.constraint[m] = c;
+            aug.s * st.lambda[m] + aug.p * c
+        };
+        (mu, gr)
+    }
+
+    /// The residual with an end between beam nodes: the rows' forces summed on the slots, then
+    /// spread through `Spreads`.
+    #[inline(never)]
+    fn residual_between(&self, st: &State, aug: Augment, r: &mut Residual) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        let mut force = [0.0; SLOTS];
+        for (k, row) in self.rows.iter().enumerate() {
+            let (mu, gr) = self.row_residual(k, row, &geo, st, aug, r);
+            force.iter_mut().zip(&gr).for_each(|(f, g)| *f += mu * g);
+        }
+        let sp = Spreads::new(&self.a, &self.b, self.angle, st);
+        sp.add_forces(&force, (&self.a, &self.b, self.angle), &mut r.force);
+    }
+
     pub fn tangent(&self, st: &State, aug: Augment, c: TangentCoeffs, k: &mut [f64]) {
         let geo = Geo::new(&self.a, &self.b, self.angle, st);
         let (map, m0) = slots(&self.a, &self.b, self.angle);
+        // Ends between beam nodes reach several unknowns per slot.
+        let spread = (self.a.is_between() || self.b.is_between())
+            .then(|| Spreads::new(&self.a, &self.b, self.angle, st));
         let nl = m0 + self.rows.len();
         k[..nl * nl].iter_mut().for_each(|x| *x = 0.0);
         let w = c.force_weight;
-        // The slots this joint assembles, with their local positions.
+        // The slots this joint assembles, with their local positions (plain ends).
         let mut live = [(0usize, 0usize); SLOTS];
         let mut nlive = 0;
         for (s, l) in map.iter().enumerate() {
@@ -380,22 +415,25 @@ impl Joint {
             let m = m0 + r;
             let (gv, gr) = row.geom(&geo);
             let lam = st.lambda[self.first + r];
+            // The row's derivative over the slots (a rate row's through the velocities too:
+            // its `s B` part).
+            let mut dc = [0.0; SLOTS];
             if row.is_rate() {
                 row.hess(&geo, aug.s * lam, &mut h);
                 let mut h1 = [[0.0; SLOTS]; SLOTS];
                 row.hess(&geo, 1.0, &mut h1);
-                for &(sj, lj) in live {
+                for &(sj, _) in live {
                     let vh: f64 = (0..SLOTS).map(|si| geo.vel[si] * h1[si][sj]).sum();
                     // `rate_scale` is `1 / velocity` (the integrator's `beta h / gamma`): the
                     // row is `s (B + rate_scale position V^T H)`, a unit-weight `s B` in the
                     // constrained mass matrix too.
-                    k[m * nl + lj] = aug.s * (gr[sj] + aug.rate_scale * c.position * vh);
+                    dc[sj] = aug.s * (gr[sj] + aug.rate_scale * c.position * vh);
                 }
             } else {
                 let f = row.drive().map_or(0.0, |f| f.eval(st.t));
                 row.hess(&geo, aug.s * lam + aug.p * (gv - f), &mut h);
-                for &(sj, lj) in live {
-                    k[m * nl + lj] = aug.s * gr[sj];
+                for &(sj, _) in live {
+                    dc[sj] = aug.s * gr[sj];
                 }
                 for &(si, _) in live {
                     let g = aug.p * gr[si];
@@ -406,15 +444,40 @@ impl Joint {
                     }
                 }
             }
-            for &(si, li) in live {
-                k[li * nl + m] = w * aug.s * gr[si];
+            match &spread {
+                None => {
+                    for &(s, l) in live {
+                        k[m * nl + l] = dc[s];
+                        k[l * nl + m] = w * aug.s * gr[s];
+                    }
+                }
+                Some(sp) => {
+                    for &(s, _) in live {
+                        // The velocities' part through their interpolation.
+                        let dv = if row.is_rate() { aug.s * gr[s] } else { 0.0 };
+                        for (l, cl) in sp.trial[s].iter() {
+                            k[m * nl + l] += (dc[s] - dv) * cl;
+                        }
+                        for (l, cl) in sp.rate[s].iter() {
+                            k[m * nl + l] += dv * cl;
+                        }
+                        for (l, cl) in sp.test[s].iter() {
+                            k[l * nl + m] += w * aug.s * gr[s] * cl;
+                        }
+                    }
+                }
             }
         }
         let wc = w * c.position;
-        for &(si, li) in live {
-            for &(sj, lj) in live {
-                k[li * nl + lj] += wc * h[si][sj];
+        match &spread {
+            None => {
+                for &(si, li) in live {
+                    for &(sj, lj) in live {
+                        k[li * nl + lj] += wc * h[si][sj];
+                    }
+                }
             }
+            Some(sp) => sp.add_matrix(&h, wc, false, k, nl),
         }
     }
 
@@ -507,6 +570,8 @@ pub(crate) fn slots(a: &End, b: &End, angle: Option<usize>) -> ([Option<usize>; 
 
 /// The global unknown of each slot (no allocation: called every iteration).
 pub(crate) fn globals(a: &End, b: &End, angle: Option<usize>) -> [Option<usize>; SLOTS] {
+    // Ends between nodes are assembled through `Spreads`, never here.
+    debug_assert!(!a.is_between() && !b.is_between());
     let mut g = [None; SLOTS];
     for (k, d) in a.dofs().iter().enumerate() {
         g[UA + k] = Some(*d);

@@ -16,12 +16,7 @@ fn compiled(model: &str, sets: &[String], request: Request) -> crate::Compiled {
 
 /// The model's integrator after `steps` steps from its consistent start.
 fn advanced(c: &crate::Compiled, steps: usize) -> Integrator<'_> {
-    let sys = &c
-        .lowered
-        .as_ref()
-        .map_err(|d| d.message.clone())
-        .unwrap()
-        .system;
+    let sys = &c.lowered.system;
     let mut it = Integrator::new(sys, &c.settings)
         .map_err(|f| f.detail)
         .unwrap();

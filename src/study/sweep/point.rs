@@ -17,8 +17,6 @@ pub enum PointError {
     /// The model did not compile with the param at this value (the compile function's
     /// message).
     Compile(String),
-    /// The model compiled but cannot run (the lowering's message).
-    NotRunnable(String),
     /// Floquet: the period is unknown.
     Period(PeriodError),
     /// Floquet: a perturbed run failed.
@@ -53,7 +51,7 @@ impl PointError {
 impl fmt::Display for PointError {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         match self {
-            PointError::Compile(m) | PointError::NotRunnable(m) | PointError::Output(m) => {
+            PointError::Compile(m) | PointError::Output(m) => {
                 write!(f, "{m}")
             }
             PointError::Period(e) => write!(f, "{e}"),
@@ -265,10 +263,7 @@ struct Found {
 }
 
 fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Result<Found, PointError> {
-    let l = c
-        .lowered
-        .as_ref()
-        .map_err(|d| PointError::NotRunnable(d.message.clone()))?;
+    let l = &c.lowered;
     let period = match spec.period {
         Some(t) => t,
         None => rotor_period(c).map_err(PointError::Period)?,
