@@ -28,6 +28,7 @@ const CASES: &[(&str, &[Code])] = &[
     ("twist_stations", &[Code::E0213, Code::E0209, Code::E0213]),
     ("curve_points", &[Code::E0224, Code::E0303, Code::E0213]),
     ("section_centres", &[Code::E0224]),
+    ("mass_matrix", &[Code::E0224, Code::E0213]),
     (
         "distributed_loads",
         &[Code::E0222, Code::E0222, Code::E0202, Code::E0401],

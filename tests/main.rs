@@ -18,6 +18,7 @@ mod friction;
 mod grammar;
 mod joints;
 mod loads;
+mod mass_matrix;
 mod mbc;
 mod models;
 mod modes;

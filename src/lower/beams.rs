@@ -17,7 +17,7 @@ use crate::runtime::{Between, End};
 fn properties(s: &Section) -> SectionAt {
     let m = s.mass_per_length;
     let eta = V3::new(0.0, s.mass_offset[0], s.mass_offset[1]);
-    let rc = M3::from_diagonal(&V3::new(s.inertia[0], s.inertia[1], s.inertia[2]));
+    let rc = m3(&s.inertia);
     let rho = rc + (M3::identity() * eta.norm_squared() - eta * eta.transpose()) * m;
     SectionAt {
         stiffness: s.stiffness,
@@ -48,7 +48,9 @@ pub fn section_at(b: &Beam, s: f64) -> SectionAt {
         }),
         mass_per_length: mix(a.mass_per_length, c.mass_per_length),
         mass_offset: std::array::from_fn(|k| mix(a.mass_offset[k], c.mass_offset[k])),
-        inertia: std::array::from_fn(|k| mix(a.inertia[k], c.inertia[k])),
+        inertia: std::array::from_fn(|r| {
+            std::array::from_fn(|k| mix(a.inertia[r][k], c.inertia[r][k]))
+        }),
     };
     properties(&section)
 }

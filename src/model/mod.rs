@@ -132,8 +132,9 @@ pub struct Section {
     pub mass_per_length: f64,
     /// Centre of mass offset in the section plane (axes 2, 3).
     pub mass_offset: [f64; 2],
-    /// Mass moments of inertia per length: polar (about 1), about 2, about 3.
-    pub inertia: [f64; 3],
+    /// Mass moments of inertia per length about the centre of mass, in the section's axes
+    /// (1: polar), products included.
+    pub inertia: [[f64; 3]; 3],
 }
 
 /// An elastic beam: geometrically exact beam elements between equally spaced nodes.

@@ -441,11 +441,9 @@ impl Builder<'_> {
         let m = s.mass_per_length * length;
         let center = [length / 2.0, s.mass_offset[0], s.mass_offset[1]];
         let bend = s.mass_per_length * length.powi(3) / 12.0;
-        let inertia = [
-            [s.inertia[0] * length, 0.0, 0.0],
-            [0.0, s.inertia[1] * length + bend, 0.0],
-            [0.0, 0.0, s.inertia[2] * length + bend],
-        ];
+        let mut inertia = s.inertia.map(|row| row.map(|x| x * length));
+        inertia[1][1] += bend;
+        inertia[2][2] += bend;
         let mut markers = vec![
             ("start".to_string(), [0.0; 3], IDENTITY),
             ("end".to_string(), [length, 0.0, 0.0], IDENTITY),

@@ -1,6 +1,7 @@
 //! Sections: the 6x6 stiffness (whole or its diagonal, with per-block units), the mass per
-//! length, its offset and inertias, checked positive; declared (`section NAME { ... }`),
-//! written in a beam, or named by one. Contract: builds `Section`s; must not build beams.
+//! length, its offset and inertias (or the whole 6x6 mass matrix), checked positive; declared
+//! (`section NAME { ... }`), written in a beam, or named by one. Contract: builds `Section`s;
+//! must not build beams.
 
 use super::{Builder, Built, View};
 use crate::diagnostics::{Code, Diagnostic};
@@ -12,6 +13,32 @@ use crate::syntax::ast::{Block, Prop, PropValue};
 use std::collections::HashMap;
 
 const BENDING: Quantity = Dim::new(1, 3, -2).quantity();
+
+/// A 6x6 section matrix: its property, the dimension of its upper-left block (length and time
+/// exponents over a mass; each of rows and columns 4-6 adds a length) and its hints.
+struct Matrix6 {
+    name: &'static str,
+    length: i8,
+    time: i8,
+    shape: &'static str,
+    units: &'static str,
+}
+
+const STIFFNESS: Matrix6 = Matrix6 {
+    name: "stiffness",
+    length: 1,
+    time: -2,
+    shape: "write `stiffness = ((EA, 0, 0, 0, 0, 0) N, ..., (0, 0, 0, 0, 0, EI3) N*m^2)`; rows and columns 1-3 in N, 4-6 in N*m, the lower-right block in N*m^2",
+    units: "rows and columns 1-3 are forces (N), 4-6 moments (N*m): the blocks are N, N*m and N*m^2",
+};
+
+const MASS: Matrix6 = Matrix6 {
+    name: "mass_matrix",
+    length: -1,
+    time: 0,
+    shape: "write `mass_matrix = ((m, 0, 0, 0, 0, 0) kg/m, ..., (0, 0, 0, 0, 0, i3) kg*m)`; rows and columns 1-3 in kg/m, the coupling blocks in kg, the lower-right block in kg*m",
+    units: "rows and columns 1-3 are per length (kg/m), the couplings kg, the inertias per length kg*m",
+};
 
 type Props = HashMap<&'static str, Prop>;
 
@@ -55,6 +82,7 @@ impl Builder<'_> {
                 "tension_offset3",
                 "shear_offset2",
                 "shear_offset3",
+                "mass_matrix",
             ],
             "a section",
         );
@@ -111,7 +139,7 @@ impl Builder<'_> {
                 );
                 return None;
             }
-            k = self.matrix6(v, sp)?;
+            k = self.matrix6(v, sp, &STIFFNESS)?;
         } else {
             for (i, (key, dim)) in DIAG.iter().enumerate() {
                 let example = if i < 3 { "8.53e7 N" } else { "1.28e4 N*m^2" };
@@ -141,14 +169,37 @@ impl Builder<'_> {
         Some((k, ok))
     }
 
-    /// The mass per length, its offset (axes 2, 3) and the inertias (polar, 2, 3).
+    /// The mass per length, its offset (axes 2, 3) and the inertias about the centre of mass
+    /// (polar, 2, 3, products): written as properties, or as the 6x6 mass matrix.
     #[allow(clippy::type_complexity)]
     fn section_mass(
         &mut self,
         v: &View,
         block: &Block,
         p: &Props,
-    ) -> Option<(f64, [f64; 2], [f64; 3])> {
+    ) -> Option<(f64, [f64; 2], [[f64; 3]; 3])> {
+        if let Some(mp) = p.get("mass_matrix") {
+            const PARTS: [&str; 6] = [
+                "mass_per_length",
+                "mass_offset2",
+                "mass_offset3",
+                "i2",
+                "i3",
+                "polar",
+            ];
+            if let Some(name) = PARTS.iter().find(|n| p.contains_key(*n)) {
+                self.error(
+                    v.scope,
+                    Diagnostic::error(Code::E0224, "a section gives either `mass_matrix` (6x6) or the mass per length, its offsets and inertias, not both")
+                        .at(p.get(name).map(|q| q.name.span).unwrap_or(mp.name.span), "engineering property")
+                        .at(mp.name.span, "full matrix")
+                        .hint("keep one of them: the 6x6 mass matrix holds the mass, its offset and the inertias"),
+                );
+                return None;
+            }
+            let m = self.matrix6(v, mp, &MASS)?;
+            return self.mass_parts(v, mp, &m);
+        }
         let mass = self
             .required(
                 v.scope,
@@ -175,13 +226,69 @@ impl Builder<'_> {
             },
         };
         let (mass, o2, o3, i2, i3, polar) = (mass?, o2?, o3?, i2?, i3?, polar?);
-        Some((mass, [o2, o3], [polar, i2, i3]))
+        let inertia = [[polar, 0.0, 0.0], [0.0, i2, 0.0], [0.0, 0.0, i3]];
+        Some((mass, [o2, o3], inertia))
+    }
+
+    /// The mass, the offset and the inertias about the centre of mass of a 6x6 mass matrix
+    /// `[[m I, m eta~^T], [m eta~, rho]]` (section axes, about the reference line): the
+    /// translational block a multiple of the identity, the coupling block `m eta~` with the
+    /// centre of mass in the section plane (E0213 otherwise; positive definiteness is checked
+    /// with the section).
+    fn mass_parts(
+        &mut self,
+        v: &View,
+        mp: &Prop,
+        m: &[[f64; 6]; 6],
+    ) -> Option<(f64, [f64; 2], [[f64; 3]; 3])> {
+        let mass = m[0][0];
+        let scale = m
+            .iter()
+            .enumerate()
+            .map(|(i, r)| r[i].abs())
+            .fold(0.0, f64::max);
+        let small = |x: f64| x.abs() <= 1e-9 * scale;
+        let translational =
+            (0..3).all(|i| (0..3).all(|j| small(m[i][j] - if i == j { mass } else { 0.0 })));
+        // The lower-left block is m eta~: its (1, 0) is m eta_3, (0, 2) m eta_2, (2, 1) m eta_1.
+        let c = |i: usize, j: usize| m[3 + i][j];
+        let eta = [c(2, 1) / mass, c(0, 2) / mass, c(1, 0) / mass];
+        let skew = (0..3).all(|i| small(c(i, i)))
+            && small(c(0, 1) + c(1, 0))
+            && small(c(0, 2) + c(2, 0))
+            && small(c(1, 2) + c(2, 1));
+        let why = if !translational {
+            Some("its translational block (rows and columns 1-3) must be the mass per length times the identity")
+        } else if !skew {
+            Some("its coupling block (rows 4-6, columns 1-3) must be `m eta~`: skew, the mass times the centre of mass's offset")
+        } else if mass > 0.0 && !small(mass * eta[0]) {
+            Some("the centre of mass lies in the section's plane: its offset along axis 1 (entries (5, 3) and (6, 2)) must be 0")
+        } else {
+            None
+        };
+        if let Some(why) = why {
+            self.error(
+                v.scope,
+                Diagnostic::error(Code::E0213, format!("`mass_matrix` is not a section's mass matrix: {why}"))
+                    .at(mp.span(), "here")
+                    .hint("rows 1-3 hold `m I` (kg/m) and `-m eta~` (kg), rows 4-6 `m eta~` (kg) and the inertias per length about the reference line (kg*m), `eta = (0, e2, e3)` the centre of mass: row 1 is `(m, 0, 0, 0, m*e3, -m*e2)`"),
+            );
+            return None;
+        }
+        // Inertias about the centre of mass: rho - m (|eta|^2 I - eta eta^T).
+        let e2 = eta[1] * eta[1] + eta[2] * eta[2];
+        let inertia = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                let parallel = if i == j { e2 } else { 0.0 } - eta[i] * eta[j];
+                m[3 + i][3 + j] - mass * parallel
+            })
+        });
+        Some((mass, [eta[1], eta[2]], inertia))
     }
 
     /// A positive mass, non-negative inertias and a symmetric positive definite stiffness.
     fn check_section(&mut self, v: &View, block: &Block, p: &Props, s: &Section) -> bool {
         let (name, mass, k) = (&s.name, s.mass_per_length, &s.stiffness);
-        let [polar, i2, i3] = s.inertia;
         if mass <= 0.0 {
             self.error(
                 v.scope,
@@ -199,7 +306,11 @@ impl Builder<'_> {
             );
             return false;
         }
-        if i2 < 0.0 || i3 < 0.0 || polar < 0.0 {
+        let j = nalgebra::Matrix3::from_fn(|i, k| s.inertia[i][k]);
+        let sym =
+            (0..3).all(|i| (0..3).all(|k| (j[(i, k)] - j[(k, i)]).abs() <= 1e-9 * j.trace().abs()));
+        let least = j.symmetric_eigenvalues().min();
+        if !sym || least < -1e-12 * j.trace().abs() {
             self.error(
                 v.scope,
                 Diagnostic::error(
@@ -207,7 +318,7 @@ impl Builder<'_> {
                     format!("section `{name}` has a negative mass moment of inertia"),
                 )
                 .at(block.span, "in this section")
-                .hint("i2, i3 and polar are non-negative (kg*m)"),
+                .hint("i2, i3 and polar are non-negative (kg*m); a mass matrix's inertias about the centre of mass must be symmetric and positive semidefinite"),
             );
             return false;
         }
@@ -227,15 +338,21 @@ impl Builder<'_> {
         true
     }
 
-    /// `stiffness = ((k11, ..., k16), ..., (k61, ..., k66))` with per-block units.
-    fn matrix6(&mut self, v: &View, p: &crate::syntax::ast::Prop) -> Option<[[f64; 6]; 6]> {
+    /// `stiffness = ((k11, ..., k16), ..., (k61, ..., k66))` (or a `mass_matrix`) with
+    /// per-block units.
+    fn matrix6(
+        &mut self,
+        v: &View,
+        p: &crate::syntax::ast::Prop,
+        kind: &Matrix6,
+    ) -> Option<[[f64; 6]; 6]> {
         use crate::syntax::ast::ExprKind;
         let bad = |this: &mut Self, span: Span| {
             this.error(
                 v.scope,
-                Diagnostic::error(Code::E0209, "`stiffness` must be a 6x6 matrix")
+                Diagnostic::error(Code::E0209, format!("`{}` must be a 6x6 matrix", kind.name))
                     .at(span, "not six rows of six")
-                    .hint("write `stiffness = ((EA, 0, 0, 0, 0, 0) N, ..., (0, 0, 0, 0, 0, EI3) N*m^2)`; rows and columns 1-3 in N, 4-6 in N*m, the lower-right block in N*m^2"),
+                    .hint(kind.shape),
             );
             None
         };
@@ -261,7 +378,7 @@ impl Builder<'_> {
                 return bad(self, row.span);
             }
             for (j, item) in items.iter().enumerate() {
-                let dim = Dim::new(1, 1 + (i >= 3) as i8 + (j >= 3) as i8, -2);
+                let dim = Dim::new(1, kind.length + (i >= 3) as i8 + (j >= 3) as i8, kind.time);
                 // A row may carry one unit after its parenthesis: apply it to every entry.
                 let val = self.value(v.scope, item)?;
                 let (x, d) = match (val, unit) {
@@ -283,7 +400,8 @@ impl Builder<'_> {
                             Diagnostic::error(
                                 Code::E0209,
                                 format!(
-                                    "a stiffness entry must be a constant scalar, found {}",
+                                    "a `{}` entry must be a constant scalar, found {}",
+                                    kind.name,
                                     other.kind_name()
                                 ),
                             )
@@ -296,9 +414,19 @@ impl Builder<'_> {
                 if x != 0.0 && d != dim {
                     self.error(
                         v.scope,
-                        Diagnostic::error(Code::E0202, format!("stiffness entry ({}, {}) must be {}, found {}", i + 1, j + 1, dim.describe(), d.describe()))
-                            .at(item.span, format!("this is {}", d.describe()))
-                            .hint("rows and columns 1-3 are forces (N), 4-6 moments (N*m): the blocks are N, N*m and N*m^2"),
+                        Diagnostic::error(
+                            Code::E0202,
+                            format!(
+                                "`{}` entry ({}, {}) must be {}, found {}",
+                                kind.name,
+                                i + 1,
+                                j + 1,
+                                dim.describe(),
+                                d.describe()
+                            ),
+                        )
+                        .at(item.span, format!("this is {}", d.describe()))
+                        .hint(kind.units),
                     );
                     return None;
                 }
