@@ -275,3 +275,35 @@ fn a_windmill_on_a_light_cantilever_tower_follows_the_windmill_on_the_slider() {
     let (x, lag) = difference(&t8, &runs[0].2);
     within("x_hub and lag, 8 vs 4 elements", x.max(lag), 2.5e-6); // measured 8.5e-7
 }
+
+/// `models/windmill_paper.mbd` (issue 23, item 5): the paper's own beam model of the windmill
+/// (a 4-node tower element with the top mass, a hub of four stiff parabolic elements, a stiff
+/// parabolic element per blade, revolute joints) follows the rigid windmill (slider tower,
+/// rigid rods) over the paper's 3 s at Omega_bar = 1. Measured, the largest difference
+/// relative to each channel's peak: x_hub 1.0e-2, lag angles 1.35e-2 at its step of 0.1 ms
+/// (at the paper's 0.5 ms the lag angles differ by 0.2: a collective lag left by the stiff
+/// beams' start transient, which shrinks 22 times at 0.1 ms).
+#[test]
+fn the_papers_beam_windmill_follows_the_rigid_windmill() {
+    let run = |path: &str| {
+        simulate_text_with(path, &read(path), &[], Request::default())
+            .unwrap_or_else(|(_, m)| panic!("{m}"))
+    };
+    let (paper, rigid) = (run("models/windmill_paper.mbd"), run("models/windmill.mbd"));
+    let (tp, tr) = (paper.col("t"), rigid.col("t"));
+    assert!(
+        tp.len() == tr.len() && tp.iter().zip(&tr).all(|(a, b)| (a - b).abs() < 1e-9),
+        "the same rows"
+    );
+    let (x, lag) = difference(&paper, &rigid);
+    within(
+        "paper's beam windmill vs the rigid windmill, x_hub",
+        x,
+        3e-2,
+    );
+    within(
+        "paper's beam windmill vs the rigid windmill, lag",
+        lag,
+        4e-2,
+    );
+}
