@@ -3,7 +3,7 @@
 
 use super::Lower;
 use crate::model::{Beam, Section};
-use crate::runtime::beams::{inertial_points, triad_between, Distributed, SectionAt};
+use crate::runtime::beams::{inertial_points, triad_between, Distributed, Gauss, SectionAt};
 use crate::runtime::rotation::{M3, V3};
 use crate::runtime::LoadKind;
 use crate::runtime::{
@@ -71,6 +71,7 @@ pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initia
     }
     let p = b.order;
     let le = b.length / b.elements as f64;
+    let mut lumped = Vec::new();
     for e in 0..b.elements {
         let local: Vec<usize> = (e * (p - 1)..=e * (p - 1) + p - 1).collect();
         let dofs = local
@@ -102,8 +103,48 @@ pub fn beam(lw: &Lower, bi: usize, b: &Beam, elements: &mut Vec<Element>, initia
                 values,
             });
         }
+        // Concentrated masses between the nodes: the mass a point of weight 1 after the
+        // inertial ones (its consistent mass `m N_k N_l`), its rotary inertia lumped on the
+        // element's nodes in proportion to `|N_k|` (a consistent rotary inertia of one point
+        // is rank 3 over all the nodes' rotations, which the start cannot tell from a node's).
+        for &(s, mass, inertia) in &b.masses_between {
+            let (at, xi) = locate(b, s);
+            if at != e {
+                continue;
+            }
+            let (n, _) = crate::runtime::beams::shape(p, xi);
+            element.inertial.push(Gauss {
+                wj: 1.0,
+                n,
+                dn: [0.0; 4],
+                strain0: [0.0; 6],
+                section: SectionAt {
+                    stiffness: [[0.0; 6]; 6],
+                    mass,
+                    eta: [0.0; 3],
+                    rho: [[0.0; 3]; 3],
+                },
+            });
+            if inertia.iter().flatten().all(|&x| x == 0.0) {
+                continue;
+            }
+            let total: f64 = n.iter().take(p).map(|x| x.abs()).sum();
+            for (j, &k) in local.iter().enumerate() {
+                let st = starts[k];
+                let w = n[j].abs() / total;
+                lumped.push(Element::RigidBody(RigidBody {
+                    dofs: [st, st + 1, st + 2, st + 3, st + 4, st + 5],
+                    node: ids[k],
+                    mass: 0.0,
+                    eta0: [0.0; 3],
+                    inertia0: inertia.map(|row| row.map(|x| x * w)),
+                    gravity: model.gravity,
+                }));
+            }
+        }
         elements.push(Element::Beam(element));
     }
+    elements.append(&mut lumped);
     // Concentrated masses: rigid bodies on the node, centred there.
     for &(node, mass, inertia) in &b.point_masses {
         let s = starts[node];

@@ -163,6 +163,8 @@ pub struct Beam {
     pub angular_velocities: Vec<[f64; 3]>,
     /// Concentrated masses on nodes: node, mass, inertia (inertial frame at t = 0).
     pub point_masses: Vec<(usize, f64, Mat3)>,
+    /// Concentrated masses between nodes: arc length, mass, inertia (inertial frame at t = 0).
+    pub masses_between: Vec<(f64, f64, Mat3)>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]

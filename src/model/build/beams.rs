@@ -152,6 +152,7 @@ impl Builder<'_> {
             frames,
             length,
             point_masses: Vec::new(),
+            masses_between: Vec::new(),
         });
         self.beam_decl.push(v.decl);
         Some(Built::Beam(self.beams.len() - 1))

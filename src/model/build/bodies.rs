@@ -501,12 +501,17 @@ impl Builder<'_> {
                 }
                 Some(Built::Mass)
             }
-            Attach::BeamNode { beam, node } => {
+            Attach::BeamNode { beam, .. } | Attach::BeamPoint { beam, .. } => {
                 let world = mat_mul(
                     mat_mul(marker.world_axes, local),
                     transpose(marker.world_axes),
                 );
-                self.beams[beam].point_masses.push((node, mass, world));
+                let b = &mut self.beams[beam];
+                match marker.attach {
+                    Attach::BeamNode { node, .. } => b.point_masses.push((node, mass, world)),
+                    Attach::BeamPoint { s, .. } => b.masses_between.push((s, mass, world)),
+                    _ => {}
+                }
                 Some(Built::Mass)
             }
             _ => {
@@ -514,11 +519,11 @@ impl Builder<'_> {
                     v.scope,
                     Diagnostic::error(
                         Code::E0306,
-                        "a concentrated mass goes on a body or a beam node",
+                        "a concentrated mass goes on a body or a beam",
                     )
-                    .at(on.span, "not on a body or a node")
+                    .at(on.span, "not on a body or a beam")
                     .hint(
-                        "attach it to a body marker or to `beam.node[k]`, `beam.start`, `beam.end`",
+                        "attach it to a body marker or to a point of a beam (`beam.node[k]`, `beam.at(s)`)",
                     ),
                 );
                 None

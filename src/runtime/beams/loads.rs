@@ -20,9 +20,13 @@ pub struct Distributed {
 }
 
 impl Distributed {
+    /// The value at inertial point `point`; zero at a concentrated mass's point (past the
+    /// quadrature's).
     fn value(&self, point: usize, t: f64) -> V3 {
-        let v = &self.values[point];
-        V3::new(v[0].eval(t), v[1].eval(t), v[2].eval(t))
+        match self.values.get(point) {
+            Some(v) => V3::new(v[0].eval(t), v[1].eval(t), v[2].eval(t)),
+            None => V3::zeros(),
+        }
     }
 }
 

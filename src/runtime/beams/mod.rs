@@ -45,7 +45,8 @@ pub struct BeamElement {
     pub gravity: [f64; 3],
     /// Distributed loads per length, their values at the inertial points.
     pub loads: Vec<Distributed>,
-    /// Reduced points (elastic terms) and full points (inertial terms).
+    /// Reduced points (elastic terms) and full points (inertial terms); concentrated masses
+    /// between the nodes follow the full points as points of weight 1.
     pub elastic: Vec<Gauss>,
     pub inertial: Vec<Gauss>,
 }
@@ -475,7 +476,8 @@ impl BeamElement {
 
     /// A typical diagonal stiffness: the mean sectional stiffness over the element length.
     pub fn stiffness_scale(&self) -> f64 {
-        let l: f64 = self.inertial.iter().map(|g| g.wj).sum();
+        // The element's length: its quadrature points (not concentrated masses' points).
+        let l: f64 = self.inertial.iter().take(self.len()).map(|g| g.wj).sum();
         let diagonal = |s: &SectionAt| (0..3).map(|i| s.stiffness[i][i]).sum::<f64>() / 3.0;
         let d: f64 = match self.uniform() {
             Some(u) => diagonal(u),
