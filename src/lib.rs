@@ -13,6 +13,7 @@
 
 pub mod channels;
 pub mod diagnostics;
+pub mod lint;
 pub mod lower;
 pub mod model;
 pub mod output;
@@ -80,9 +81,38 @@ pub fn compile_with(
     solve: Request,
     loader: &dyn Loader,
 ) -> Result<Compiled, CompileFailure> {
+    compile_inner(name, text, sets, solve, loader, false)
+}
+
+/// The sizing lint of a compiled model (`mbd explain W0701`): `name`, `text`, `sets`,
+/// `solve` and `loader` as `c` was compiled from them, to compile its rigid beams elastic.
+pub fn lint(
+    c: &Compiled,
+    name: &str,
+    text: &str,
+    sets: &[String],
+    solve: Request,
+    loader: &dyn Loader,
+) -> lint::Lint {
+    let has_rigid_beams = c.model.bodies.iter().any(|b| b.beam_axis.is_some());
+    let elastic = has_rigid_beams
+        .then(|| compile_inner(name, text, sets, solve, loader, true).ok())
+        .flatten();
+    lint::lint(c, elastic.as_ref())
+}
+
+fn compile_inner(
+    name: &str,
+    text: &str,
+    sets: &[String],
+    solve: Request,
+    loader: &dyn Loader,
+    elastic: bool,
+) -> Result<Compiled, CompileFailure> {
     let mut overrides = Overrides {
         sets: Vec::new(),
         solve,
+        elastic,
     };
     let mut sources = SourceMap::new();
     let id = sources.add(name, text);
@@ -194,6 +224,7 @@ impl Compiled {
             FailureKind::NewtonDiverged => (Code::E0601, "Newton iteration failed", "try a smaller time step (--dt), more numerical dissipation (--alpha -0.3), or check for a load or motion that is discontinuous or too large"),
             FailureKind::Singular => (Code::E0602, "singular iteration matrix", "check that every body has a positive mass and that no two joints constrain the same motion"),
             FailureKind::NonFinite => (Code::E0603, "non-finite values", "try a smaller time step (--dt); check params for extreme values"),
+            FailureKind::Inconsistent => (Code::E0608, "redundant constraints inconsistent in motion", "the joints' equations depended on each other at the start but not along the motion (a singular position: a mechanism folded flat, links in line); start the model away from it, or free one of the joints (a spherical instead of a revolute)"),
             FailureKind::Interrupted => (Code::E0607, "run interrupted", "the run was stopped (Ctrl-C); the output keeps every row computed before it"),
             FailureKind::Unsupported => (Code::E0604, "integrator not available", "time finite elements integrate rotations incrementally: drop `--rotations conformal`, or use `--integrator hht` for the conformal treatment"),
         };

@@ -61,7 +61,8 @@ const CASES: &[(&str, &[Code])] = &[
     ("missing_solve", &[Code::E0229]),
     ("run_cannot_finish", &[Code::E0230]),
     ("output_call_component", &[Code::E0212, Code::E0212]),
-    ("redundant_constraints", &[Code::E0307]),
+    ("redundant_constraints", &[Code::W0303]),
+    ("redundant_drive", &[Code::E0307]),
     ("massless_motion", &[Code::E0308]),
     ("markers_apart", &[Code::E0310]),
     ("inertia_not_physical", &[Code::E0311]),
@@ -75,6 +76,9 @@ const CASES: &[(&str, &[Code])] = &[
     ("unused_declaration", &[Code::W0202, Code::W0202]),
     ("angle_without_unit", &[Code::W0203]),
     ("floating_body", &[Code::W0301]),
+    ("stiff_beam", &[Code::W0701]),
+    ("flexible_rigid_beam", &[Code::W0702]),
+    ("unread_part", &[Code::W0703]),
 ];
 
 /// Codes snapshotted by the other tests of this file (run-time failures, `--set`, imports).
@@ -91,6 +95,7 @@ const ELSEWHERE: &[Code] = &[
     Code::E0605,
     Code::W0601,
     Code::W0602,
+    Code::E0608,
 ];
 
 #[test]
@@ -195,7 +200,21 @@ fn compile_case(name: &str, source: &str, sets: &[String]) -> (Vec<Diagnostic>, 
         sets,
         Request::default(),
     ) {
-        Ok(c) => (c.warnings, c.sources),
+        Ok(c) => {
+            // The sizing lint's warnings follow the compiler's, as `mbd check` reports them.
+            let lint = mbd::lint(
+                &c,
+                name,
+                source,
+                sets,
+                Request::default(),
+                &mbd::model::NoFiles,
+            );
+            (
+                c.warnings.into_iter().chain(lint.diagnostics).collect(),
+                c.sources,
+            )
+        }
         Err(f) => (f.diagnostics, f.sources),
     };
     assert_located(name, &diags, &sources);
@@ -347,6 +366,23 @@ fn without_solver_digits(text: &str) -> String {
     out
 }
 
+/// A parallelogram four-bar started with its links in line: a singular position, where its
+/// joints' equations are dependent (W0303) only there.
+const PARALLELOGRAM_IN_LINE: &str =
+    "model para \"a parallelogram four-bar started with its links in line\"
+gravity = (0, -9.81, 0) m/s^2
+ground earth
+rigid_rod crank { from = (0, 0, 0) m, to = (0.3, 0, 0) m, mass = 1 kg }
+rigid_rod coupler { from = (0.3, 0, 0) m, to = (0.8, 0, 0) m, mass = 2 kg }
+rigid_rod rocker { from = (0.5, 0, 0) m, to = (0.8, 0, 0) m, mass = 1 kg }
+joint j1 = revolute(earth, crank.start) { axis = z }
+joint j2 = revolute(crank.end, coupler.start) { axis = z }
+joint j3 = revolute(coupler.end, rocker.end) { axis = z }
+joint j4 = revolute(earth @ (0.5, 0, 0) m, rocker.start) { axis = z }
+output theta = j1.angle
+solve hht { dt = 1 ms, until = 1 s }
+";
+
 #[test]
 fn runtime_diagnostics_name_when_and_where() {
     let pendulum = read("models/pendulum.mbd");
@@ -392,6 +428,12 @@ fn runtime_diagnostics_name_when_and_where() {
             pendulum.replace("velocity = (V0, 0, 0)", "velocity = (V0, -0.05 m/s, 0)"),
             two_steps(),
             Code::W0601,
+        ),
+        (
+            "run_redundant_inconsistent",
+            PARALLELOGRAM_IN_LINE.to_string(),
+            Request::default(),
+            Code::E0608,
         ),
         (
             "run_position_projected",

@@ -1,5 +1,6 @@
 //! The language reference compiles: every ```mbd block of docs/language.md is a complete model
-//! the compiler accepts (without warnings), and every ```mbd,error block is rejected, with the
+//! the compiler accepts (without warnings; a ```mbd,warning block with one), and every ```mbd,error
+//! block is rejected, with the
 //! code its `# error EXXXX` comment names. Blocks with any other tag (```text, ```sh) are prose.
 
 use mbd::diagnostics::render_human;
@@ -13,6 +14,8 @@ enum Expect {
     Accept,
     /// ```mbd,error: is rejected.
     Reject,
+    /// ```mbd,warning: compiles, with a warning (what the example shows).
+    Warn,
 }
 
 /// One compiled example: its number among the examples (from 1), the line of its opening fence,
@@ -80,6 +83,7 @@ fn examples() -> Vec<Example> {
             let expect = match tag.trim() {
                 "mbd" => Some(Expect::Accept),
                 "mbd,error" => Some(Expect::Reject),
+                "mbd,warning" => Some(Expect::Warn),
                 _ => None,
             };
             open = Some((expect, n + 1, String::new()));
@@ -114,7 +118,7 @@ fn docs_have_enough_examples() {
 #[test]
 fn every_mbd_example_compiles() {
     let mut failures = Vec::new();
-    for e in examples().iter().filter(|e| e.expect == Expect::Accept) {
+    for e in examples().iter().filter(|e| e.expect != Expect::Reject) {
         if let Err(f) = e.compile() {
             failures.push(format!("{}\n{}", e.describe(), render(&f)));
         }
@@ -148,6 +152,11 @@ fn mbd_examples_have_no_warnings() {
         noisy.len(),
         noisy.join("\n\n")
     );
+    for e in examples().iter().filter(|e| e.expect == Expect::Warn) {
+        if let Ok(c) = e.compile() {
+            assert!(!c.warnings.is_empty(), "{} warns of nothing", e.describe());
+        }
+    }
 }
 
 #[test]

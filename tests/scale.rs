@@ -35,10 +35,13 @@ fn a_chain_of_two_thousand_links_gets_every_rank_check() {
         "joint again = revolute(rod[1999].end, rod[2000].start) { axis = z }",
     ));
     assert_eq!(d.len(), 1, "{:?}", d);
-    assert_eq!(d[0].code, Code::E0307);
-    assert_eq!(
-        d[0].message,
-        "redundant constraints: `hinge[1999]`, `again` lock the same motion (5 equations too many)"
+    assert_eq!(d[0].code, Code::W0303);
+    assert!(
+        d[0].message.starts_with(
+            "redundant constraints: `hinge[1999]`, `again` lock the same motion (5 equations too many)"
+        ),
+        "{}",
+        d[0].message
     );
     assert!(d[0]
         .hint
@@ -68,9 +71,9 @@ fn a_long_closed_loop_is_checked_as_one_block() {
         "joint close = revolute(earth @ (5, 0, 0) m, rod[50].end) { axis = z }",
     ));
     assert_eq!(d.len(), 1, "{:?}", d);
-    assert_eq!(d[0].code, Code::E0307);
+    assert_eq!(d[0].code, Code::W0303);
     assert!(
-        d[0].message.ends_with("(4 equations too many)"),
+        d[0].message.contains("(4 equations too many)"),
         "{}",
         d[0].message
     );
@@ -108,13 +111,12 @@ fn large_loops_reduced_on_a_tree_agree_with_the_dense_check() {
             }
             let d = diagnostics(&model);
             assert_eq!(d.len(), 1, "{kind} {n}: {:?}", d);
-            assert_eq!(d[0].code, Code::E0307);
+            // Dense blocks' surplus is dropped at run time (W0303); a loop reduced on a tree
+            // is refused.
+            let code = if n > 100 { Code::E0307 } else { Code::W0303 };
+            assert_eq!(d[0].code, code, "{kind} {n}");
             let tail = format!("({too_many} equations too many)");
-            assert!(
-                d[0].message.ends_with(&tail),
-                "{kind} {n}: {}",
-                d[0].message
-            );
+            assert!(d[0].message.contains(&tail), "{kind} {n}: {}", d[0].message);
             assert_eq!(
                 d[0].labels.len(),
                 n + 1,
@@ -124,8 +126,9 @@ fn large_loops_reduced_on_a_tree_agree_with_the_dense_check() {
     }
     let d = diagnostics(&chain(2000, &closing(2000, "revolute")));
     assert_eq!(d.len(), 1, "{:?}", d);
+    assert_eq!(d[0].code, Code::E0307);
     assert!(
-        d[0].message.ends_with("(4 equations too many)"),
+        d[0].message.contains("(4 equations too many)"),
         "{}",
         d[0].message
     );

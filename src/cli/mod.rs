@@ -109,6 +109,35 @@ pub fn compile(
     }
 }
 
+/// [`compile`], then the sizing lint (`mbd check` and `mbd run`): the lint's warnings are
+/// reported with the compiler's.
+pub fn compile_linted(
+    path: &str,
+    text: &str,
+    sets: &[String],
+    request: Request,
+    format: Format,
+) -> Result<(Compiled, mbd::lint::Lint), ExitCode> {
+    let loader = FsLoader::new();
+    match mbd::compile_with(path, text, sets, request.clone(), &loader) {
+        Ok(c) => {
+            let lint = mbd::lint(&c, path, text, sets, request, &loader);
+            let all: Vec<_> = c
+                .warnings
+                .iter()
+                .chain(&lint.diagnostics)
+                .cloned()
+                .collect();
+            report(&all, &c.sources, format);
+            Ok((c, lint))
+        }
+        Err(f) => {
+            report(&f.diagnostics, &f.sources, format);
+            Err(ExitCode::from(EXIT_MODEL))
+        }
+    }
+}
+
 /// The model of a study or a sweep, compiled again by each job in its worker thread: silently,
 /// a failure kept as its first error.
 pub struct Jobs<'a> {

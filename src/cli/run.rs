@@ -3,7 +3,7 @@
 //! simulation fails (the rows before the failure are kept).
 
 use super::progress::Steps;
-use super::{compile, read_as, report, sink, to_path, usage, Format, EXIT_RUNTIME};
+use super::{compile_linted, read_as, report, sink, to_path, usage, Format, EXIT_RUNTIME};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mbd::settings::{Method, NewtonMode, Request, Rotations, Start};
 use std::process::ExitCode;
@@ -95,8 +95,8 @@ pub fn run(a: RunArgs) -> ExitCode {
         Ok(t) => t,
         Err(code) => return code,
     };
-    let c = match compile(&a.model, &text, &a.set, request, format) {
-        Ok(c) => c,
+    let c = match compile_linted(&a.model, &text, &a.set, request, format) {
+        Ok((c, _)) => c,
         Err(code) => return code,
     };
     let mut sink = match sink(output) {

@@ -190,11 +190,16 @@ unknown.";
 carry it), a joint that locks the rotation of a point mass, a load on the ground, a point of a \
 beam that does not say which (`start`, `end`, `node[k]`, `at(s)`).";
     E0307 = "E0307", "redundant constraints",
-        "Some joints lock the same motion: the constraint Jacobian at the initial configuration has \
-lower rank than the number of constraint equations, so the multipliers are not unique and the \
-iteration matrix is singular. The report names the joints whose equations are dependent. A \
-classic case is a four-bar linkage built from revolute joints only (one equation too many in \
-space): make one of them spherical. Two joints between the same pair of bodies are another.";
+        "Some joints lock the same motion and a drive takes part: the constraint Jacobian at the \
+initial configuration has lower rank than the number of constraint equations, and one of the \
+dependent equations is a prescribed angle, rate or slide, a motion the other joints already \
+fix or tie to another. A prescription cannot be dropped the way a joint's surplus equation is \
+(W0303: redundant joints without a drive run, their surplus dropped), so the model is \
+refused. So is a redundancy in a loop of over 600 unknowns (its surplus is found on a spanning \
+tree at check time, but not dropped at run time). The report names the joints whose equations \
+are dependent. Drive a motion the joints \
+leave free, or free one of the joints (a spherical instead of a revolute, a cylindrical instead \
+of a prismatic).";
     E0308 = "E0308", "motion without inertia or restraint",
         "Some motion of the model has no mass or inertia and is held by no joint or spring, so the \
 iteration matrix is singular: for instance a massless rigid body attached by a spherical joint \
@@ -255,6 +260,14 @@ Newmark family (`hht`, `generalized_alpha`) only.";
 keeps every row computed before it (the CSV's last row is whole), and `mbd` exits with code \
 130. In a sweep or a study every run still to go stops the same way and what was finished \
 is written. A second Ctrl-C ends the process at once.";
+    E0608 = "E0608", "redundant constraints inconsistent in motion",
+        "The joints' equations depended on each other at the initial configuration (W0303), so \
+the run dropped the surplus, and it watches the dropped equations: one drifted by more than \
+1e-6 (m, or rad for an axis). The start was a singular position, where the joints' equations \
+are dependent only there (a four-bar folded flat, a parallelogram with its links in line): \
+away from it they are independent, and the dropped equation is a constraint the mechanism \
+needs. The run stops at the step that shows it, naming the joint, and keeps the rows so far. \
+Start the model away from the singular position, or free one of the joints.";
     E0605 = "E0605", "no steady motion for modal analysis",
         "`mbd modes` linearizes the equations about the initial state, and that linearization has \
 modes only if the state is a steady motion: an equilibrium (at rest, or a uniform translation), \
@@ -291,6 +304,58 @@ each other densely. A group with more than 3,000 free motions (some 500 massless
 to each other, none held) would take minutes, so it is not checked and this warning says so. \
 If such a motion exists, the run stops at its first step with a singular iteration matrix \
 (E0602). Give the bodies mass and inertia, or hold them.";
+    W0701 = "W0701", "beam stiffer than the scene needs",
+        "The sizing lint (run by `mbd check` and before `mbd run`) measures each elastic beam in \
+its assembly: the model linearized at rest at its initial configuration, on its joints, with \
+the masses it carries; the beam's frequency is the lowest of the modes in which it stores at \
+least a tenth of the strain energy, and its deformation the quasi-static response in those \
+modes to the scene's loads (gravity, the inertial \
+forces of the initial motion through its consistent accelerations and the centripetal ones of \
+each beam's spin, every load at 65 times over the run and at its piecewise knots), less the \
+beam's best rigid motion. The scene's band is the highest of: 10 times the fastest rotor speed \
+(its harmonics to 10/rev, from the initial spin and the drives), the characteristic frequency of \
+every time function in a load or a drive (`max |f''| / max |f'|` over the run, `w` for \
+`sin(w t)`; `2 pi / dt` for a piecewise function's shortest interval), and the highest \
+frequency of the modes no beam owns (the scene's own motion: a pendulum's swing, a lag mode). Beams alike (same length, nodes and frequency: a rotor's blades) take the \
+largest deformation among them. A beam is reported when it deforms at most 1e-4 of its length \
+AND its frequency is at least 10 times the scene's band (nothing excites it), or at least 1 per \
+step (`w h >= 1`: the step cannot resolve its vibration, the integrator only damps it), or it \
+deforms at most 1e-7 of its length (even a resonance amplifying it 1,000 times, a damping \
+ratio of 0.05 %, keeps it under 1e-4). Such a beam \
+behaves as a rigid body at this step and these loads, but costs 6 unknowns a node and invites \
+the instability of stiff midpoint integration. Write `beam NAME rigid { ... }` (the same \
+declaration: its markers, `at(s)` and `node[k]` points keep working). The lint is dense and \
+skips models of over 2,000 unknowns besides multipliers or 1,500 free motions (`mbd check` \
+says so); `mbd check` prints each beam's figures and verdict.";
+    W0702 = "W0702", "rigid beam more flexible than the scene allows",
+        "A `beam NAME rigid` is measured as the elastic beam it declares, in its assembly (the \
+model compiled with every rigid beam elastic; the figures as for W0701). It is reported when, \
+as an elastic beam, it would deform at least 1e-3 of its length under the scene's loads, or \
+its frequency would be within 3 times the scene's band while the step resolves it (`w h < 1`): \
+then its elasticity changes the motion by more than a tenth of a percent, or its resonance is \
+within reach. Drop `rigid` to model it as a beam.";
+    W0703 = "W0703", "part that no output depends on",
+        "No output channel reads the part, and no joint, spring, beam or two-ended load connects \
+it (other than through a ground, which does not move) to a part an output reads: its motion \
+cannot change any written column. It still costs unknowns and steps. Remove it, or add an \
+output that reads it. Parts are rigid bodies, point masses and beams; a model without outputs \
+is not checked.";
+    W0303 = "W0303", "redundant but consistent constraints",
+        "The joints' equations depend on each other at the initial configuration, no drive among \
+them: a planar four-bar of four revolute joints about parallel axes (three equations too many in \
+3-D), two hinges on one axis, a swashplate or pitch-link loop. Engineers build mechanisms so; \
+the joints hold at the start (their markers coincide) and imply each other. The run drops the \
+surplus equations (the rows the others span, chosen by pivoted Gram-Schmidt at the start and \
+again after every step, keeping the set while it stays well conditioned), keeps watching \
+them, and stops with E0608 if one drifts past 1e-6 (m, or rad for an axis): that is a \
+singular position, where the mechanism locks or branches, not a redundancy. How the joints \
+share the load is not determined by a rigid model; the reported joint forces are the \
+minimum-norm split of the forces the loop carries (rows of moment units weighed divided by \
+the model's length). A drive among the dependent equations, or a loop of over 600 unknowns, \
+is refused instead (E0307). To have a split of your choosing, free \
+joints until the warning goes (a spherical instead of a revolute, a cylindrical instead of a \
+prismatic: a four-bar becomes revolute-revolute-spherical-cylindrical), or make a link \
+elastic.";
     W0601 = "W0601", "initial velocities projected onto the constraints",
         "The initial velocities violate the joints' velocity constraints. They were projected onto \
 the constraints in the metric of the mass matrix, which is exactly the impulsive response of the \

@@ -171,6 +171,7 @@ pub fn joint(lw: &Lower, ji: usize, j: &ModelJoint) -> Lowered {
             first: dofs.joint_start[ji],
             rows,
             slide_offset,
+            slot: None,
         },
         forces,
     }

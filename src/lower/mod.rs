@@ -6,6 +6,7 @@
 
 mod beams;
 mod joints;
+mod redundant;
 
 use crate::model::dofs::Unknown;
 use crate::model::{
@@ -206,6 +207,16 @@ pub fn lower(model: &Model) -> (System, Provenance) {
         elements.push(Element::Load(joints::load(&lw, l)));
     }
     let (unknowns, owners) = lw.unknowns(&rate_rows);
+    let surplus: Vec<usize> = model.redundant.iter().map(|&j| joint_element[j]).collect();
+    if !surplus.is_empty() {
+        redundant::drop_surplus(
+            &mut elements,
+            &surplus,
+            &unknowns,
+            &mut initial,
+            length_scale(model),
+        );
+    }
     let channels = model
         .outputs
         .iter()
@@ -225,6 +236,7 @@ pub fn lower(model: &Model) -> (System, Provenance) {
         initial,
         channels,
         length_scale: length_scale(model),
+        redundant: surplus,
     };
     (system, Provenance { spans })
 }

@@ -55,6 +55,9 @@ pub struct Overrides {
     pub sets: Vec<(crate::syntax::ast::Ident, crate::syntax::ast::Expr)>,
     /// The command line's solver settings, laid over the `solve` block's.
     pub solve: crate::settings::Request,
+    /// Build every `beam NAME rigid` as the elastic beam it declares (the sizing lint's
+    /// W0702 measures them so).
+    pub elastic: bool,
 }
 
 pub type Mat3 = [[f64; 3]; 3];
@@ -81,6 +84,9 @@ pub struct Model {
     /// What the `solve` block wrote (resolved with the command line by `Settings::resolve`).
     pub solve: crate::settings::Written,
     pub dofs: DofMap,
+    /// The joints whose equations are redundant but consistent (W0303): the run drops their
+    /// surplus rows.
+    pub redundant: Vec<usize>,
 }
 
 #[derive(Clone, Debug, Serialize)]

@@ -15,7 +15,7 @@ pub mod beams;
 mod bodies;
 mod elements;
 mod forces;
-mod joints;
+pub mod joints;
 mod probes;
 pub mod rotation;
 pub mod timefn;
@@ -84,11 +84,64 @@ pub struct System {
     pub channels: Vec<Channel>,
     /// A length typical of the model, for scaling Newton increments.
     pub length_scale: f64,
+    /// The joints (element indices) whose equations are redundant but consistent: some of
+    /// their rows dropped, their reactions reported as the minimum-norm split.
+    #[serde(default)]
+    pub redundant: Vec<usize>,
 }
 
 impl System {
     pub fn len(&self) -> usize {
         self.unknowns.len()
+    }
+
+    /// The force and moment joint element `e` applies on its end B: the minimum-norm split
+    /// for a redundant joint ([`joints::min_norm_reaction`]).
+    pub fn joint_reaction(&self, e: usize, st: &State, aug: Augment) -> Option<(V3, V3)> {
+        let Element::Joint(j) = &self.elements[e] else {
+            return None;
+        };
+        if self.redundant.contains(&e) {
+            if let Some(r) = joints::min_norm_reaction(
+                &self.elements,
+                &self.redundant,
+                e,
+                st,
+                aug,
+                self.length_scale,
+            ) {
+                return Some(r);
+            }
+        }
+        Some(j.reaction(st, aug))
+    }
+
+    /// The rows of the redundant joints to drop at `st`, `count` of them (see
+    /// [`joints::select_dropped`]): `st.dropped` while the rows it keeps stay well apart;
+    /// `None` without redundant joints.
+    pub fn select_dropped(&self, st: &State, count: usize) -> Option<Vec<u16>> {
+        (!self.redundant.is_empty()).then(|| {
+            joints::select_dropped(
+                &self.elements,
+                &self.redundant,
+                &self.unknowns,
+                st,
+                self.length_scale,
+                Some(count),
+            )
+        })
+    }
+
+    /// The largest drift of a dropped redundant row and its joint's entity (the owner of
+    /// its first multiplier), if any row is dropped.
+    pub fn dropped_violation(&self, st: &State) -> Option<(f64, usize)> {
+        self.redundant
+            .iter()
+            .filter_map(|&e| match &self.elements[e] {
+                Element::Joint(j) => Some((j.dropped_violation(st), self.owners[j.first])),
+                _ => None,
+            })
+            .max_by(|a, b| a.0.total_cmp(&b.0))
     }
 
     /// The `(multiplier, angle unknown)` pairs of the revolute joints' angle rows, whose
@@ -226,6 +279,10 @@ pub struct State {
     pub rot: Vec<NodeRotation>,
     /// Body-frame velocities of the rotating nodes (incremental treatment).
     pub frames: Vec<Frame>,
+    /// Per redundant joint (W0303, in the order of [`System::redundant`]): the rows dropped
+    /// now (bit `k`: row `k`), chosen again as the mechanism moves.
+    #[serde(default)]
+    pub dropped: Vec<u16>,
 }
 
 /// A rotating node's body-frame twist `(R^T x-dot, R^T omega)`, its rate and the integrator's
@@ -248,6 +305,7 @@ impl State {
             alg: vec![0.0; n],
             rot: vec![NodeRotation::REST; nodes],
             frames: vec![Frame::default(); nodes],
+            dropped: Vec::new(),
         }
     }
 
@@ -265,6 +323,7 @@ impl State {
         }
         self.rot.copy_from_slice(&other.rot);
         self.frames.copy_from_slice(&other.frames);
+        self.dropped.copy_from_slice(&other.dropped);
     }
 
     /// The first unknown holding a non-finite value, if any.

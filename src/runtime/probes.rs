@@ -209,20 +209,21 @@ impl System {
                 element,
                 component,
                 axes,
-            } => match &self.elements[*element] {
-                Element::Joint(j) => match component {
-                    Some(c) => resolve(j.reaction(st, aug).0, axes.as_ref(), st)[*c],
-                    None => j.multiplier_force(st, aug, 0),
+            } => match (&self.elements[*element], component) {
+                (Element::Joint(_), Some(c)) => match self.joint_reaction(*element, st, aug) {
+                    Some((f, _)) => resolve(f, axes.as_ref(), st)[*c],
+                    None => f64::NAN,
                 },
+                (Element::Joint(j), None) => j.multiplier_force(st, aug, 0),
                 _ => f64::NAN,
             },
             Probe::JointMoment {
                 element,
                 component,
                 axes,
-            } => match &self.elements[*element] {
-                Element::Joint(j) => resolve(j.reaction(st, aug).1, axes.as_ref(), st)[*component],
-                _ => f64::NAN,
+            } => match self.joint_reaction(*element, st, aug) {
+                Some((_, m)) => resolve(m, axes.as_ref(), st)[*component],
+                None => f64::NAN,
             },
             Probe::JointAngle { element } => self.joint_angle(*element, st, false),
             Probe::JointRate { element } => self.joint_angle(*element, st, true),

@@ -79,6 +79,9 @@ pub enum TimeFn {
     },
 }
 
+/// A piecewise function's knots `(t_k, v_k)`.
+pub type Knots = [(f64, f64)];
+
 /// A value with its first and second time derivatives.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Jet {
@@ -143,6 +146,58 @@ impl TimeFn {
     /// Whether the function depends on the span coordinate `span`.
     pub fn has_arc(&self) -> bool {
         self.depends(&|f| matches!(f, TimeFn::Arc))
+    }
+
+    /// The function's characteristic angular frequency over `[0, until]` (rad/s), for the
+    /// sizing lint: `max |f''| / max |f'|` over 1,000 samples (`w` for `sin(w t)`, zero for a
+    /// constant or a ramp), and `2 pi / dt` for the shortest interval `dt > 0` between the knots
+    /// of a piecewise function inside the run (its corners). Jumps count as no frequency.
+    pub fn frequency(&self, until: f64) -> f64 {
+        const SAMPLES: usize = 1000;
+        let (mut d, mut dd) = (0.0_f64, 0.0_f64);
+        for k in 0..=SAMPLES {
+            let j = self.jet(until * k as f64 / SAMPLES as f64);
+            (d, dd) = (d.max(j.d.abs()), dd.max(j.dd.abs()));
+        }
+        let smooth = if d > 0.0 && dd.is_finite() {
+            dd / d
+        } else {
+            0.0
+        };
+        let mut corners = 0.0_f64;
+        self.each_piecewise(&mut |knots| {
+            for w in knots.windows(2) {
+                let gap = w[1].0 - w[0].0;
+                if gap > 0.0 && w[0].0 < until {
+                    corners = corners.max(2.0 * std::f64::consts::PI / gap);
+                }
+            }
+        });
+        smooth.max(corners)
+    }
+
+    /// The times of the knots of every piecewise function in the tree (where such a function
+    /// peaks), for sampling it.
+    pub fn knot_times(&self) -> Vec<f64> {
+        let mut out = Vec::new();
+        self.each_piecewise(&mut |knots| out.extend(knots.iter().map(|k| k.0)));
+        out
+    }
+
+    /// Calls `visit` with the knots of every piecewise function in the tree.
+    fn each_piecewise(&self, visit: &mut dyn FnMut(&Knots)) {
+        match self {
+            TimeFn::Const { .. } | TimeFn::Time | TimeFn::Arc => {}
+            TimeFn::Unary { arg, .. } | TimeFn::Pow { arg, .. } => arg.each_piecewise(visit),
+            TimeFn::Piecewise { knots, arg, .. } => {
+                visit(knots);
+                arg.each_piecewise(visit);
+            }
+            TimeFn::Binary { lhs, rhs, .. } => {
+                lhs.each_piecewise(visit);
+                rhs.each_piecewise(visit);
+            }
+        }
     }
 
     /// Whether any leaf of the tree satisfies `leaf`.
@@ -479,5 +534,35 @@ mod tests {
         assert_eq!(h.eval(3.0), 4.0);
         assert_eq!(h.jet(3.0).d, 4.0);
         assert_eq!(h.jet(3.0).dd, 2.0);
+    }
+
+    #[test]
+    fn a_sine_has_its_frequency_a_ramp_none_and_corners_theirs() {
+        let w = 7.0;
+        let sine = TimeFn::Unary {
+            op: Unary::Sin,
+            arg: Box::new(TimeFn::binary(
+                Binary::Mul,
+                TimeFn::constant(w),
+                TimeFn::Time,
+            )),
+        };
+        // Over whole periods the sampled maxima are the amplitude's to 1e-4.
+        let f = sine.frequency(2.0 * std::f64::consts::PI);
+        assert!((f / w - 1.0).abs() < 1e-4, "{f}");
+        let offset = TimeFn::binary(Binary::Add, TimeFn::constant(5.0), sine);
+        assert!((offset.frequency(2.0 * std::f64::consts::PI) / w - 1.0).abs() < 1e-4);
+        assert_eq!(TimeFn::Time.frequency(1.0), 0.0);
+        assert_eq!(TimeFn::constant(3.0).frequency(1.0), 0.0);
+        let pulse = TimeFn::Piecewise {
+            knots: vec![(0.0, 0.0), (0.005, 20.0), (0.01, 0.0)],
+            outside: Outside::Hold,
+            arg: Box::new(TimeFn::Time),
+        };
+        let corners = 2.0 * std::f64::consts::PI / 0.005;
+        assert!((pulse.frequency(3.0) / corners - 1.0).abs() < 1e-12);
+        assert_eq!(pulse.knot_times(), vec![0.0, 0.005, 0.01]);
+        // Knots after the run do not count.
+        assert_eq!(pulse.frequency(-1.0), 0.0);
     }
 }

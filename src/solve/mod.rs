@@ -13,6 +13,7 @@ pub mod linear;
 pub mod modes;
 mod ordering;
 mod pivot_free;
+pub mod sizing;
 mod steady;
 
 pub use integrator::{Integrator, Linearization, Stop};
@@ -29,6 +30,8 @@ pub enum FailureKind {
     Unsupported,
     /// Stopped by [`interrupt`] (Ctrl-C) between steps.
     Interrupted,
+    /// A redundant joint's dropped equation drifted: not redundant along the motion.
+    Inconsistent,
 }
 
 static INTERRUPTED: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);

@@ -72,7 +72,7 @@ impl Builder<'_> {
         let b = self.beam_layout(v, &p)?;
         let d = sub(b.to, b.from);
         let n = b.elements * (b.order - 1) + 1;
-        let rigid = Self::has_flag(v, "rigid");
+        let rigid = Self::has_flag(v, "rigid") && !self.elastic;
         // Each node's position and axis 1: along the curve through `points`, or the straight
         // line from `from` to `to`.
         let (length, along) = match &b.points {
@@ -119,7 +119,7 @@ impl Builder<'_> {
             let s = length * k as f64 / (n - 1) as f64;
             *f = mat_mul(*f, rotation([1.0, 0.0, 0.0], twist_at(&b.twist.0, s)));
         }
-        if Self::has_flag(v, "rigid") {
+        if rigid {
             return self.rigid_beam(v, &b, length, n, frames[0]);
         }
         let nodes: Vec<[f64; 3]> = along.iter().map(|&(x, _)| x).collect();

@@ -79,6 +79,8 @@ pub(super) struct Builder<'s> {
     pub distributed: Vec<DistributedLoad>,
     /// Set while a distributed load's value is built: the only place `span` may appear.
     pub span_allowed: bool,
+    /// `beam NAME rigid` builds the elastic beam ([`Overrides::elastic`]).
+    pub elastic: bool,
     pub built: Vec<Option<Built>>,
     /// Declaration spans of bodies and beams (for topology messages).
     pub body_decl: Vec<usize>,
@@ -166,6 +168,7 @@ fn build_model(
         }
     };
     let mut b = Builder::new(env, sink);
+    b.elastic = overrides.elastic;
     let params = b.params(top);
     let gravity = match &out.gravity {
         Some((g, _)) => b
@@ -199,8 +202,9 @@ fn build_model(
         exact,
         solve: solve?,
         dofs: DofMap::default(),
+        redundant: Vec::new(),
     };
-    topology::check(&model, b.sink);
+    model.redundant = topology::check(&model, b.sink);
     if b.sink.has_errors() {
         return None;
     }
@@ -259,6 +263,7 @@ impl<'s> Builder<'s> {
             loads: Vec::new(),
             distributed: Vec::new(),
             span_allowed: false,
+            elastic: false,
             body_decl: Vec::new(),
             beam_decl: Vec::new(),
         }

@@ -220,7 +220,9 @@ fn locks_rotation(k: &JointKind) -> bool {
     !matches!(k, JointKind::Spherical | JointKind::Distance { .. })
 }
 
-pub fn check(model: &Model, sink: &mut Sink) {
+/// Returns the joints whose equations are redundant but consistent (W0303): the run drops
+/// their surplus equations.
+pub fn check(model: &Model, sink: &mut Sink) -> Vec<usize> {
     let cols = columns(model);
     // A joint that locks rotations needs something that rotates on at least one side.
     let mut bad = false;
@@ -244,7 +246,7 @@ pub fn check(model: &Model, sink: &mut Sink) {
         }
     }
     if bad {
-        return;
+        return Vec::new();
     }
     connectivity(model, sink);
     let scale = length_scale(model);
@@ -260,13 +262,16 @@ pub fn check(model: &Model, sink: &mut Sink) {
         joint_rows(&mut r, j);
         owner.extend(std::iter::repeat_n(ji, r.rows.len() - before));
     }
-    if !r.rows.is_empty() {
-        redundancy(model, &r, &owner, sink);
-    }
+    let redundant = if r.rows.is_empty() {
+        Vec::new()
+    } else {
+        redundancy(model, &r, &owner, sink)
+    };
     if sink.has_errors() {
-        return;
+        return Vec::new();
     }
     massless::check(model, &mut r, sink);
+    redundant
 }
 
 /// The vertex of the ground in the joint graph, after every node's.
@@ -446,8 +451,11 @@ fn connectivity(model: &Model, sink: &mut Sink) {
     }
 }
 
-/// Dependent constraint equations (E0307): the null space of `J J^T`, block by block.
-fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
+/// Dependent constraint equations, the null space of `J J^T` block by block: W0303 when no
+/// drive takes part (joints' equations that hold at the start and imply each other: the run
+/// drops the surplus), E0307 when one does (a prescribed motion that the other joints fix or
+/// couple). Returns the joints of consistent dependencies.
+fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) -> Vec<usize> {
     let m = r.rows.len();
     let mut first = vec![usize::MAX; model.joints.len()];
     for (i, &o) in owner.iter().enumerate().rev() {
@@ -455,6 +463,16 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
     }
     let (mut involved, mut nulls) = (vec![0.0f64; model.joints.len()], 0);
     let rows_of = |j: usize| first[j]..(first[j]..m).find(|&i| owner[i] != j).unwrap_or(m);
+    // A drive's row is its joint's last (see `joint_rows`).
+    let driven = |i: usize| {
+        let j = owner[i];
+        let last = rows_of(j).end - 1;
+        i == last
+            && matches!(&model.joints[j].kind,
+                JointKind::Revolute { drive, .. } | JointKind::Prismatic { drive, .. }
+                    if !matches!(drive, Drive::Free))
+    };
+    let (mut drive_involved, mut large) = (false, false);
     for block in loop_blocks(model, r.cols) {
         let rows: Vec<usize> = block.iter().flat_map(|&j| rows_of(j)).collect();
         let mut nodes: Vec<usize> = block
@@ -471,8 +489,11 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
         if width > DENSE_BLOCK {
             for dep in tree::dependencies(model, r, &block, &rows_of) {
                 nulls += 1;
+                large = true;
+                let top = dep.iter().fold(0.0f64, |a, (_, v)| a.max(v.abs()));
                 for (i, v) in dep {
                     involved[owner[i]] = involved[owner[i]].max(v.abs());
+                    drive_involved |= driven(i) && v.abs() > 1e-6 * top;
                 }
             }
             continue;
@@ -484,12 +505,14 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
         for c in (0..rows.len()).filter(|&c| eig.eigenvalues[c].abs() <= tol) {
             nulls += 1;
             for (k, &i) in rows.iter().enumerate() {
-                involved[owner[i]] = involved[owner[i]].max(eig.eigenvectors[(k, c)].abs());
+                let v = eig.eigenvectors[(k, c)].abs();
+                involved[owner[i]] = involved[owner[i]].max(v);
+                drive_involved |= driven(i) && v > 1e-6;
             }
         }
     }
     if nulls == 0 {
-        return;
+        return Vec::new();
     }
     let names: Vec<usize> = (0..model.joints.len())
         .filter(|&k| involved[k] > 1e-6)
@@ -499,21 +522,47 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) {
         .map(|&k| format!("`{}`", model.joints[k].name))
         .collect::<Vec<_>>()
         .join(", ");
-    let mut d = Diagnostic::error(
-        Code::E0307,
-        format!(
-            "redundant constraints: {list} lock the same motion ({nulls} equation{} too many)",
-            if nulls == 1 { "" } else { "s" }
-        ),
-    );
+    let plural = if nulls == 1 { "" } else { "s" };
+    let refuse = drive_involved || large;
+    let mut d = if large && !drive_involved {
+        Diagnostic::error(
+            Code::E0307,
+            format!("redundant constraints: {list} lock the same motion ({nulls} equation{plural} too many), in a loop too large to drop equations from"),
+        )
+    } else if drive_involved {
+        Diagnostic::error(
+            Code::E0307,
+            format!("redundant constraints: {list} lock the same motion, a drive among them ({nulls} equation{plural} too many)"),
+        )
+    } else {
+        Diagnostic::warning(
+            Code::W0303,
+            format!("redundant constraints: {list} lock the same motion ({nulls} equation{plural} too many); the run drops {nulls} of their equations, and their forces are one split among many"),
+        )
+    };
     for &k in &names {
         d = d.at(
             model.joints[k].span,
             format!("{} joint", model.joints[k].kind.name()),
         );
     }
-    sink.push(d.hint(format!(
-        "the constraint Jacobian has rank {} for {m} equations at the initial configuration; free one of these joints (a spherical instead of a revolute, a cylindrical instead of a prismatic) or remove it",
-        m - nulls
-    )));
+    let rank = m - nulls;
+    sink.push(if large && !drive_involved {
+        d.hint(format!(
+            "the constraint Jacobian has rank {rank} for {m} equations at the initial configuration; a loop of over {DENSE_BLOCK} unknowns is not reduced at run time: free one of these joints (a spherical instead of a revolute, a cylindrical instead of a prismatic)"
+        ))
+    } else if drive_involved {
+        d.hint(format!(
+            "the constraint Jacobian has rank {rank} for {m} equations at the initial configuration, and a drive prescribes a motion the other joints already fix: drive a free motion, or free one of these joints (a spherical instead of a revolute, a cylindrical instead of a prismatic)"
+        ))
+    } else {
+        d.hint(format!(
+            "the constraint Jacobian has rank {rank} for {m} equations at the initial configuration; the joint forces reported are the minimum-norm split (the mechanism cannot tell how the joints share the load); to have one split, free one of these joints (a spherical instead of a revolute, a cylindrical instead of a prismatic)"
+        ))
+    });
+    if refuse {
+        Vec::new()
+    } else {
+        names
+    }
 }

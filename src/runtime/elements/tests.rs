@@ -44,6 +44,8 @@ const ROT_B: [usize; 3] = [9, 10, 11];
 
 fn random_state(rng: &mut Lcg) -> State {
     let mut st = State::zeros(N, 2);
+    // Rows 1 and 4 of the joint in slot 0 dropped as redundant (W0303).
+    st.dropped = vec![0b10010];
     st.t = 0.3 + rng.next().abs();
     for i in 0..N {
         st.q[i] = rng.next();
@@ -171,6 +173,17 @@ fn elements(rng: &mut Lcg, case: usize) -> Vec<Element> {
             first: 13,
             rows: all_rows(),
             slide_offset: Some(0.3),
+            slot: None,
+        }),
+        // The same with rows 1 and 4 dropped as redundant (W0303): held at lambda = 0.
+        Element::Joint(Joint {
+            a: a.clone(),
+            b: b.clone(),
+            angle: Some(12),
+            first: 13,
+            rows: all_rows(),
+            slide_offset: Some(0.3),
+            slot: Some(0),
         }),
         Element::Spring(Spring {
             kind: SpringKind::Torsional,

@@ -26,8 +26,12 @@ pub(crate) type Grad = [f64; SLOTS];
 pub(crate) type Hess = [[f64; SLOTS]; SLOTS];
 
 mod ends;
+mod outputs;
+mod redundant;
+
 pub use ends::{Between, End, EndKin};
 pub(crate) use ends::{Geo, Spreads};
+pub use redundant::{min_norm_reaction, select_dropped};
 
 /// A primitive constraint row. Axis indices are 0-based (`a_0` is the marker's first axis).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -322,9 +326,22 @@ pub struct Joint {
     pub rows: Vec<Row>,
     /// For prismatic joints: the initial `a_2 . d`, so the displacement starts at zero.
     pub slide_offset: Option<f64>,
+    /// For a joint whose equations are redundant (W0303): its entry in `State::dropped`, the
+    /// rows dropped now (the other joints' rows imply them). A dropped row keeps its
+    /// multiplier, held at zero (`lambda = 0`, diagonal `s`), applies no force, and is
+    /// watched: [`Joint::violation`] still measures it.
+    #[serde(default)]
+    pub slot: Option<usize>,
 }
 
 impl Joint {
+    /// Whether row `k` is dropped as redundant at `st`.
+    #[inline(always)]
+    pub fn is_dropped(&self, k: usize, st: &State) -> bool {
+        self.slot
+            .is_some_and(|s| st.dropped.get(s).is_some_and(|m| m & (1 << k) != 0))
+    }
+
     pub fn indices(&self) -> Vec<usize> {
         let mut v = Vec::with_capacity(13 + self.rows.len());
         v.extend_from_slice(self.a.dofs());
@@ -362,6 +379,10 @@ impl Joint {
         r: &mut Residual,
     ) -> (f64, Grad) {
         let m = self.first + k;
+        if self.is_dropped(k, st) {
+            r.constraint[m] = st.lambda[m];
+            return (0.0, [0.0; SLOTS]);
+        }
         let (gv, gr) = row.geom(geo);
         let f = row.drive().map_or(0.0, |f| f.eval(st.t));
         let mu = if row.is_rate() {
@@ -413,6 +434,10 @@ impl Joint {
         let mut h = [[0.0; SLOTS]; SLOTS];
         for (r, row) in self.rows.iter().enumerate() {
             let m = m0 + r;
+            if self.is_dropped(r, st) {
+                k[m * nl + m] = aug.s;
+                continue;
+            }
             let (gv, gr) = row.geom(&geo);
             let lam = st.lambda[self.first + r];
             // The row's derivative over the slots (a rate row's through the velocities too:
@@ -484,6 +509,10 @@ impl Joint {
     pub fn constraint_rate(&self, st: &State, rate: Rate, out: &mut [f64]) {
         let geo = Geo::new(&self.a, &self.b, self.angle, st);
         for (k, row) in self.rows.iter().enumerate() {
+            if self.is_dropped(k, st) {
+                out[self.first + k] = 0.0;
+                continue;
+            }
             let (_, gr) = row.geom(&geo);
             let jet = row.drive().map(|f| f.jet(st.t));
             let (f0, f1, f2) = jet.map_or((0.0, 0.0, 0.0), |j| (j.v, j.d, j.dd));
@@ -500,57 +529,6 @@ impl Joint {
                 }
             };
         }
-    }
-
-    /// The physical force `mu` of row `row`.
-    pub fn multiplier_force(&self, st: &State, aug: Augment, row: usize) -> f64 {
-        let m = self.first + row;
-        if self.rows[row].is_rate() {
-            aug.s * st.lambda[m]
-        } else {
-            aug.s * st.lambda[m] + aug.p * self.violation_row(st, row)
-        }
-    }
-
-    fn violation_row(&self, st: &State, row: usize) -> f64 {
-        let geo = Geo::new(&self.a, &self.b, self.angle, st);
-        let r = &self.rows[row];
-        let f = r.drive().map_or(0.0, |f| f.eval(st.t));
-        let (gv, gr) = r.geom(&geo);
-        if r.is_rate() {
-            dot13(&gr, &geo.vel) - f
-        } else {
-            gv - f
-        }
-    }
-
-    /// The largest constraint violation (position rows; rate rows in their own units).
-    pub fn violation(&self, st: &State) -> f64 {
-        (0..self.rows.len())
-            .map(|r| self.violation_row(st, r).abs())
-            .fold(0.0, f64::max)
-    }
-
-    /// The force and the moment (about the marker point) that the joint applies on end B,
-    /// inertial components.
-    pub fn reaction(&self, st: &State, aug: Augment) -> (V3, V3) {
-        let geo = Geo::new(&self.a, &self.b, self.angle, st);
-        let (mut f, mut m) = (V3::zeros(), V3::zeros());
-        for (r, row) in self.rows.iter().enumerate() {
-            let mu = self.multiplier_force(st, aug, r);
-            let (_, gr) = row.geom(&geo);
-            f -= V3::new(gr[UB], gr[UB + 1], gr[UB + 2]) * mu;
-            m -= V3::new(gr[TB], gr[TB + 1], gr[TB + 2]) * mu;
-        }
-        (f, m - geo.b.p.cross(&f))
-    }
-
-    /// A prismatic joint's displacement and speed along its axis.
-    pub fn slide(&self, st: &State) -> (f64, f64) {
-        let geo = Geo::new(&self.a, &self.b, self.angle, st);
-        let mut gr = [0.0; SLOTS];
-        let x = along(&geo, 2, self.slide_offset.unwrap_or(0.0), &mut gr);
-        (x, dot13(&gr, &geo.vel))
     }
 }
 

@@ -153,6 +153,10 @@ pub struct Integrator<'s> {
 }
 
 /// Why a step attempt failed, before it is turned into a [`RuntimeFailure`].
+/// The drift (m, or rad for an axis) past which a redundant joint's dropped row stops the run
+/// (W0303: the joints were redundant at the start but are not along the motion).
+pub const DROPPED_DRIFT: f64 = 1e-6;
+
 pub(super) struct StepFailure {
     kind: FailureKind,
     entity: Option<usize>,
@@ -378,6 +382,34 @@ impl<'s> Integrator<'s> {
         self.step_index = index;
         self.advance(h, 0).map_err(|f| self.fail(f))?;
         self.stats.steps += 1;
+        // Redundant joints (W0303): their dropped rows must have held; then the rows to drop
+        // are chosen again at the new configuration (those the others span best: where the
+        // kept ones grow dependent, as Bricard's linkage passes a special position, others
+        // take over), and a kept matrix is made again when they change.
+        if let Some((drift, entity)) = self.sys.dropped_violation(&self.cur) {
+            if drift > DROPPED_DRIFT {
+                return Err(self.fail(StepFailure {
+                    kind: FailureKind::Inconsistent,
+                    entity: Some(entity),
+                    detail: format!("a redundant equation the run dropped drifted by {drift:.2e} (m, or rad for an axis): the joints are not redundant along the motion, the start was a singular position"),
+                }));
+            }
+            let count = self
+                .sys
+                .initial
+                .dropped
+                .iter()
+                .map(|m| m.count_ones() as usize)
+                .sum();
+            if let Some(masks) = self.sys.select_dropped(&self.cur, count) {
+                if masks != self.cur.dropped {
+                    for st in [&mut self.cur, &mut self.trial, &mut self.mid] {
+                        st.dropped.clone_from(&masks);
+                    }
+                    self.kept = None;
+                }
+            }
+        }
         Ok(())
     }
 
