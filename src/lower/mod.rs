@@ -215,6 +215,7 @@ pub fn lower(model: &Model) -> (System, Provenance) {
             &unknowns,
             &mut initial,
             length_scale(model),
+            model.surplus,
         );
     }
     let channels = model

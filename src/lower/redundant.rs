@@ -9,18 +9,20 @@
 use crate::runtime::joints::select_dropped;
 use crate::runtime::{Element, State, UnknownKind};
 
-/// Gives the joint elements `joints` their slots and `st` their masks at the start.
+/// Gives the joint elements `joints` their slots and `st` their masks at the start:
+/// `surplus` rows dropped (as many as the model check counted).
 pub fn drop_surplus(
     elements: &mut [Element],
     joints: &[usize],
     unknowns: &[UnknownKind],
     st: &mut State,
     length: f64,
+    surplus: usize,
 ) {
     for (slot, &e) in joints.iter().enumerate() {
         if let Element::Joint(j) = &mut elements[e] {
             j.slot = Some(slot);
         }
     }
-    st.dropped = select_dropped(elements, joints, unknowns, st, length, None);
+    st.dropped = select_dropped(elements, joints, unknowns, st, length, Some(surplus));
 }

@@ -87,6 +87,8 @@ pub struct Model {
     /// The joints whose equations are redundant but consistent (W0303): the run drops their
     /// surplus rows.
     pub redundant: Vec<usize>,
+    /// How many of their equations are surplus (the run drops that many).
+    pub surplus: usize,
 }
 
 #[derive(Clone, Debug, Serialize)]

@@ -132,6 +132,28 @@ impl System {
         })
     }
 
+    /// Row `row`'s force of joint element `e` (a distance joint's tension): its share in the
+    /// minimum-norm split for a redundant joint.
+    pub fn joint_row_force(&self, e: usize, st: &State, aug: Augment, row: usize) -> f64 {
+        let Element::Joint(j) = &self.elements[e] else {
+            return f64::NAN;
+        };
+        if self.redundant.contains(&e) {
+            let split = joints::min_norm_forces(
+                &self.elements,
+                &self.redundant,
+                e,
+                st,
+                aug,
+                self.length_scale,
+            );
+            if let Some(mu) = split {
+                return mu[row];
+            }
+        }
+        j.multiplier_force(st, aug, row)
+    }
+
     /// The largest drift of a dropped redundant row and its joint's entity (the owner of
     /// its first multiplier), if any row is dropped.
     pub fn dropped_violation(&self, st: &State) -> Option<(f64, usize)> {

@@ -214,7 +214,7 @@ impl System {
                     Some((f, _)) => resolve(f, axes.as_ref(), st)[*c],
                     None => f64::NAN,
                 },
-                (Element::Joint(j), None) => j.multiplier_force(st, aug, 0),
+                (Element::Joint(_), None) => self.joint_row_force(*element, st, aug, 0),
                 _ => f64::NAN,
             },
             Probe::JointMoment {

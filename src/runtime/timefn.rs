@@ -189,8 +189,11 @@ impl TimeFn {
         match self {
             TimeFn::Const { .. } | TimeFn::Time | TimeFn::Arc => {}
             TimeFn::Unary { arg, .. } | TimeFn::Pow { arg, .. } => arg.each_piecewise(visit),
+            // Knots are times only when the argument is `t` itself.
             TimeFn::Piecewise { knots, arg, .. } => {
-                visit(knots);
+                if matches!(**arg, TimeFn::Time) {
+                    visit(knots);
+                }
                 arg.each_piecewise(visit);
             }
             TimeFn::Binary { lhs, rhs, .. } => {

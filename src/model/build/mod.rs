@@ -203,8 +203,9 @@ fn build_model(
         solve: solve?,
         dofs: DofMap::default(),
         redundant: Vec::new(),
+        surplus: 0,
     };
-    model.redundant = topology::check(&model, b.sink);
+    (model.redundant, model.surplus) = topology::check(&model, b.sink);
     if b.sink.has_errors() {
         return None;
     }

@@ -220,9 +220,9 @@ fn locks_rotation(k: &JointKind) -> bool {
     !matches!(k, JointKind::Spherical | JointKind::Distance { .. })
 }
 
-/// Returns the joints whose equations are redundant but consistent (W0303): the run drops
-/// their surplus equations.
-pub fn check(model: &Model, sink: &mut Sink) -> Vec<usize> {
+/// Returns the joints whose equations are redundant but consistent (W0303) and how many of
+/// their equations are surplus: the run drops that many.
+pub fn check(model: &Model, sink: &mut Sink) -> (Vec<usize>, usize) {
     let cols = columns(model);
     // A joint that locks rotations needs something that rotates on at least one side.
     let mut bad = false;
@@ -246,7 +246,7 @@ pub fn check(model: &Model, sink: &mut Sink) -> Vec<usize> {
         }
     }
     if bad {
-        return Vec::new();
+        return (Vec::new(), 0);
     }
     connectivity(model, sink);
     let scale = length_scale(model);
@@ -263,12 +263,12 @@ pub fn check(model: &Model, sink: &mut Sink) -> Vec<usize> {
         owner.extend(std::iter::repeat_n(ji, r.rows.len() - before));
     }
     let redundant = if r.rows.is_empty() {
-        Vec::new()
+        (Vec::new(), 0)
     } else {
         redundancy(model, &r, &owner, sink)
     };
     if sink.has_errors() {
-        return Vec::new();
+        return (Vec::new(), 0);
     }
     massless::check(model, &mut r, sink);
     redundant
@@ -455,7 +455,7 @@ fn connectivity(model: &Model, sink: &mut Sink) {
 /// drive takes part (joints' equations that hold at the start and imply each other: the run
 /// drops the surplus), E0307 when one does (a prescribed motion that the other joints fix or
 /// couple). Returns the joints of consistent dependencies.
-fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) -> Vec<usize> {
+fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) -> (Vec<usize>, usize) {
     let m = r.rows.len();
     let mut first = vec![usize::MAX; model.joints.len()];
     for (i, &o) in owner.iter().enumerate().rev() {
@@ -512,7 +512,7 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) -> Vec<
         }
     }
     if nulls == 0 {
-        return Vec::new();
+        return (Vec::new(), 0);
     }
     let names: Vec<usize> = (0..model.joints.len())
         .filter(|&k| involved[k] > 1e-6)
@@ -561,8 +561,8 @@ fn redundancy(model: &Model, r: &Rows, owner: &[usize], sink: &mut Sink) -> Vec<
         ))
     });
     if refuse {
-        Vec::new()
+        (Vec::new(), 0)
     } else {
-        names
+        (names, nulls)
     }
 }

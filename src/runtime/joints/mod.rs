@@ -31,7 +31,7 @@ mod redundant;
 
 pub use ends::{Between, End, EndKin};
 pub(crate) use ends::{Geo, Spreads};
-pub use redundant::{min_norm_reaction, select_dropped};
+pub use redundant::{min_norm_forces, min_norm_reaction, select_dropped};
 
 /// A primitive constraint row. Axis indices are 0-based (`a_0` is the marker's first axis).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

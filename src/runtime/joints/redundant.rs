@@ -68,6 +68,22 @@ pub fn min_norm_reaction(
     aug: Augment,
     length: f64,
 ) -> Option<(V3, V3)> {
+    let mu = min_norm_forces(elements, group, which, st, aug, length)?;
+    let Element::Joint(j) = &elements[which] else {
+        return None;
+    };
+    Some(j.reaction_from(st, &mu))
+}
+
+/// The row forces of joint element `which` in the minimum-norm split of the group's.
+pub fn min_norm_forces(
+    elements: &[Element],
+    group: &[usize],
+    which: usize,
+    st: &State,
+    aug: Augment,
+    length: f64,
+) -> Option<Vec<f64>> {
     let mut joints = Vec::new();
     for &e in group {
         let Element::Joint(j) = &elements[e] else {
@@ -111,14 +127,13 @@ pub fn min_norm_reaction(
     let top = svd.singular_values.amax();
     let nu = svd.solve(&force, 1e-12 * top).ok()?;
     let at = joints.iter().position(|(e, _, _)| *e == which)?;
-    let j = joints[at].1;
     let mut mu: Vec<f64> = joints[at].2.iter().map(|(_, m, _)| *m).collect();
     for (r, (g, k, _, _, scale)) in rows.iter().enumerate() {
         if *g == at {
             mu[*k] = nu[r] / scale;
         }
     }
-    Some(j.reaction_from(st, &mu))
+    Some(mu)
 }
 
 /// The rows to drop among those of the redundant joints `group` (element indices) at `st`:
@@ -136,6 +151,7 @@ pub fn select_dropped(
     count: Option<usize>,
 ) -> Vec<u16> {
     let (rows, dense) = unit_rows(elements, group, unknowns, st, length);
+    let count = count.map(|c| c.min(rows.len()));
     let (masks, worst) = pivoted(&rows, dense.clone(), group.len(), count, None);
     // Hysteresis: the rows dropped now stay dropped while the rows they keep are at least a
     // quarter as far apart as the best choice's (switching at every tie would drop a row
@@ -243,7 +259,8 @@ fn pivoted(
             .filter(|&(_, &i)| !dropped_now(i))
             .map(|(at, &i)| (at, norm(i)))
             .fold((0, -1.0), |a, b| if b.1 > a.1 { b } else { a });
-        if best < 0.0 || (count.is_none() && best <= 1e-9) {
+        // A row with nothing left is spanned whatever the count asks.
+        if best <= 0.0 || (count.is_none() && best <= 1e-9) {
             break;
         }
         worst = worst.min(best);

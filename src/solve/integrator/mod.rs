@@ -153,8 +153,9 @@ pub struct Integrator<'s> {
 }
 
 /// Why a step attempt failed, before it is turned into a [`RuntimeFailure`].
-/// The drift (m, or rad for an axis) past which a redundant joint's dropped row stops the run
-/// (W0303: the joints were redundant at the start but are not along the motion).
+/// The drift past which a redundant joint's dropped row stops the run (W0303: the joints were
+/// redundant at the start but are not along the motion): this (m, or rad for an axis), or
+/// 10^4 Newton tolerances if larger, times the model's length when over 1 m.
 pub const DROPPED_DRIFT: f64 = 1e-6;
 
 pub(super) struct StepFailure {
@@ -387,7 +388,9 @@ impl<'s> Integrator<'s> {
         // kept ones grow dependent, as Bricard's linkage passes a special position, others
         // take over), and a kept matrix is made again when they change.
         if let Some((drift, entity)) = self.sys.dropped_violation(&self.cur) {
-            if drift > DROPPED_DRIFT {
+            let limit = DROPPED_DRIFT.max(1e4 * self.set.increment_tolerance)
+                * self.sys.length_scale.max(1.0);
+            if drift > limit {
                 return Err(self.fail(StepFailure {
                     kind: FailureKind::Inconsistent,
                     entity: Some(entity),

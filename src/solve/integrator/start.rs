@@ -113,6 +113,10 @@ impl Integrator<'_> {
     /// at its time, keeping the symbolic factorization, then initializes as [`Self::initialize`]
     /// does. Floquet analysis starts its perturbed runs this way.
     pub fn restart(&mut self, initial: &State) -> Result<Vec<Notice>, RuntimeFailure> {
+        // A kept matrix made with other rows dropped (W0303) is not this start's.
+        if self.cur.dropped != initial.dropped {
+            self.kept = None;
+        }
         self.cur.clone_from(initial);
         self.trial.clone_from(initial);
         self.mid.clone_from(initial);
