@@ -238,6 +238,28 @@ fn check_prints_the_topology_and_every_stage() {
     let o = mbd(&["check", "models/pendulum.mbd", "--format", "json"]);
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("summary JSON");
     assert_eq!(v["multipliers"], 1);
+    // The sizing lint: its verdict on each beam, in the summary and as warnings.
+    let o = mbd(&["check", "models/two_bar_beams.mbd", "--format", "json"]);
+    assert_eq!(code(&o), 0);
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).expect("summary JSON");
+    assert_eq!(v["sizing"]["beams"][0]["beam"], "bar1");
+    assert_eq!(v["sizing"]["beams"][0]["verdict"], "could be rigid (W0701)");
+    let w: serde_json::Value = serde_json::from_slice(&o.stderr).expect("JSON warnings");
+    assert_eq!(
+        (w[0]["code"].as_str(), w[1]["code"].as_str()),
+        (Some("W0701"), Some("W0701"))
+    );
+    let o = mbd(&["check", "models/windmill_paper.mbd"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(text.contains("tower: lowest elastic"), "{text}");
+    assert!(text.contains("elastic, needed"), "{text}");
+    // Every shipped model gets the lint's verdict.
+    for entry in std::fs::read_dir(crate::common::repo("models")).expect("models/") {
+        let path = entry.expect("entry").path();
+        let o = mbd(&["check", path.to_str().expect("utf-8 path")]);
+        let text = String::from_utf8_lossy(&o.stdout);
+        assert!(text.contains("  sizing  "), "{}: {text}", path.display());
+    }
 }
 
 #[test]

@@ -84,10 +84,10 @@ fn summary(c: &mbd::Compiled, lint: &mbd::lint::Lint, format: Format) -> String 
     )
 }
 
-/// The sizing lint's figures: the scene's band, then one line per beam (empty without beams).
+/// The sizing lint's figures: the scene's band, then one line per beam.
 fn sizing(lint: &mbd::lint::Lint) -> String {
     if lint.beams.is_empty() && lint.not_sized.is_none() {
-        return String::new();
+        return "  sizing       no beams to size\n".into();
     }
     let mut out = format!("  sizing       scene band {:.3e} rad/s", lint.band);
     if let Some(h) = lint.dt {

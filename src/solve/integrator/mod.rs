@@ -318,6 +318,11 @@ impl<'s> Integrator<'s> {
         }
     }
 
+    /// How far a redundant joint's dropped row may drift ([`DROPPED_DRIFT`]).
+    fn dropped_limit(&self) -> f64 {
+        DROPPED_DRIFT.max(1e4 * self.set.increment_tolerance) * self.sys.length_scale.max(1.0)
+    }
+
     fn is_mult(&self, i: usize) -> bool {
         self.sys.unknowns[i].is_multiplier()
     }
@@ -388,9 +393,7 @@ impl<'s> Integrator<'s> {
         // kept ones grow dependent, as Bricard's linkage passes a special position, others
         // take over), and a kept matrix is made again when they change.
         if let Some((drift, entity)) = self.sys.dropped_violation(&self.cur) {
-            let limit = DROPPED_DRIFT.max(1e4 * self.set.increment_tolerance)
-                * self.sys.length_scale.max(1.0);
-            if drift > limit {
+            if drift > self.dropped_limit() {
                 return Err(self.fail(StepFailure {
                     kind: FailureKind::Inconsistent,
                     entity: Some(entity),

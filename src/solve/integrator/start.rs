@@ -156,6 +156,17 @@ impl Integrator<'_> {
             self.sc.beta * self.set.dt * self.set.dt,
         );
         notices.extend(self.project_positions()?);
+        // Redundant joints (W0303): the rows dropped are projected with the others only
+        // through them, so they must hold already.
+        if let Some((off, entity)) = self.sys.dropped_violation(&self.trial) {
+            if off > self.dropped_limit() {
+                return Err(StepFailure {
+                    kind: FailureKind::Inconsistent,
+                    entity: Some(entity),
+                    detail: format!("a redundant equation the run dropped is off by {off:.2e} (m, or rad for an axis) at the start: the joints' equations do not hold together"),
+                });
+            }
+        }
         if self.method == Method::Static {
             // Statics: no rates; multipliers come with the first load step.
             let tr = &mut self.trial;
