@@ -36,6 +36,9 @@ enum Command {
     /// Stability sweep: characteristic exponents (Floquet, Prony) against a param.
     #[command(long_about = cli::stability::LONG_ABOUT)]
     Stability(cli::stability::StabilityArgs),
+    /// Join the shares of a stability sweep (`mbd stability --shard K/N`) into its CSV and chart.
+    #[command(long_about = cli::merge::LONG_ABOUT)]
+    Merge(cli::merge::MergeArgs),
     /// Explain a diagnostic code, e.g. `mbd explain E0202`.
     Explain { code: String },
 }
@@ -62,6 +65,7 @@ fn main() -> ExitCode {
         Command::Plot(args) => cli::plot::plot(args),
         Command::Study(args) => cli::study::study(args),
         Command::Stability(args) => cli::stability::stability(args),
+        Command::Merge(args) => cli::merge::merge(args),
         Command::Explain { code } => cli::explain::explain(&code),
     };
     if mbd::solve::interrupted() {

@@ -33,6 +33,7 @@ mod rotor;
 mod rotor_stability;
 mod scale;
 mod shapes;
+mod shards;
 mod sizing;
 mod spectral;
 mod study;

@@ -8,6 +8,7 @@
 pub mod check;
 pub mod explain;
 mod loader;
+pub mod merge;
 pub mod modes;
 pub mod plot;
 mod progress;

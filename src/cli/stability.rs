@@ -133,10 +133,15 @@ pub struct StabilityArgs {
     /// modes, frequency with the per-rev lines above their real parts (campbell).
     #[arg(long, value_enum, default_value = "real")]
     chart_kind: ChartKind,
+    /// Run the K-th of N shares of the sweep (1 <= K <= N) and write it to -o as a share
+    /// file; `mbd merge` joins the N shares into the sweep's CSV and chart (a Slurm job
+    /// array: K = $SLURM_ARRAY_TASK_ID).
+    #[arg(long, value_name = "K/N", conflicts_with_all = ["chart", "reference"])]
+    shard: Option<String>,
 }
 
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
-enum ChartKind {
+pub(super) enum ChartKind {
     Real,
     Campbell,
 }
@@ -147,11 +152,30 @@ enum MonodromyArg {
     Runs,
 }
 
+impl MonodromyArg {
+    fn name(self) -> &'static str {
+        match self {
+            MonodromyArg::Tangent => "tangent",
+            MonodromyArg::Runs => "runs",
+        }
+    }
+}
+
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum MethodArg {
     Floquet,
     Prony,
     Both,
+}
+
+impl MethodArg {
+    fn name(self) -> &'static str {
+        match self {
+            MethodArg::Floquet => "floquet",
+            MethodArg::Prony => "prony",
+            MethodArg::Both => "both",
+        }
+    }
 }
 
 pub fn stability(a: StabilityArgs) -> ExitCode {
@@ -179,7 +203,16 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         Ok(r) => r.unwrap_or_default(),
         Err(code) => return code,
     };
-    let (mut csv_file, mut chart_file) = match create_outputs(&a.output, a.chart.as_deref()) {
+    let shard = match a
+        .shard
+        .as_deref()
+        .map(|s| parse_shard(s, swept.values.len()))
+    {
+        Some(Err(code)) => return code,
+        Some(Ok(k)) => Some(k),
+        None => None,
+    };
+    let (mut csv_file, chart_file) = match create_outputs(&a.output, a.chart.as_deref()) {
         Ok(files) => files,
         Err(code) => return code,
     };
@@ -205,6 +238,20 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         sets: &a.set,
     };
     let progress = Evaluations::new("evaluations");
+    if let Some(shard) = shard {
+        let run = describe_run(&a, &text);
+        let label = mbd::param_label(&c, &spec.param);
+        let names = (run.as_str(), c.model.name.as_str(), label.as_str());
+        let share = sweep::share::sweep_share(
+            &spec,
+            shard,
+            &|extra| jobs.with_sets(extra),
+            &|t| progress.tick(t),
+            names,
+        );
+        progress.finish();
+        return super::merge::write_share(&share, csv_file, &a.output);
+    }
     // The CSV rewritten as the grid's points finish (at most every STREAM_EVERY), then whole.
     let stream = Mutex::new((&mut csv_file, None::<Instant>));
     let rows = |partial: &sweep::Sweep| {
@@ -224,28 +271,89 @@ pub fn stability(a: StabilityArgs) -> ExitCode {
         &rows,
     );
     progress.finish();
-    if let Err(e) = rewrite(&mut csv_file, &result) {
-        return usage(&format!("cannot write `{}`: {e}", a.output));
+    let label = mbd::param_label(&c, &spec.param);
+    let names = (c.model.name.as_str(), label.as_str());
+    finish(
+        &result,
+        (&mut csv_file, &a.output),
+        chart_file,
+        a.chart_kind,
+        names,
+        reference,
+    )
+}
+
+/// The sweep's CSV written whole, its chart drawn (titled with the model's name, the param's
+/// axis label), its report printed; the exit code.
+pub(super) fn finish(
+    result: &sweep::Sweep,
+    (csv_file, output): (&mut std::fs::File, &str),
+    mut chart_file: super::ChartFile,
+    kind: ChartKind,
+    (model, label): (&str, &str),
+    reference: Vec<Series>,
+) -> ExitCode {
+    if let Err(e) = rewrite(csv_file, result) {
+        return usage(&format!("cannot write `{output}`: {e}"));
     }
     if let Some((p, f)) = chart_file.as_mut() {
-        let mut panels = match a.chart_kind {
+        let mut panels = match kind {
             ChartKind::Real => {
-                let title = format!("{}: growth rates Re s against {}", c.model.name, spec.param);
+                let title = format!("{model}: growth rates Re s against {}", result.param);
                 vec![result.chart(&title, reference)]
             }
             ChartKind::Campbell => {
-                let title = format!("{}: Campbell diagram against {}", c.model.name, spec.param);
+                let title = format!("{model}: Campbell diagram against {}", result.param);
                 result.campbell(&title, reference)
             }
         };
-        let label = mbd::param_label(&c, &spec.param);
         for panel in &mut panels {
-            panel.x_label.clone_from(&label);
+            panel.x_label = label.to_string();
         }
         draw_panels(p, f, &panels);
     }
-    print_report(&result);
+    print_report(result);
     exit_unless_failed(result.points.iter().any(|p| p.failure.is_some()))
+}
+
+/// `--shard K/N`: 1 <= K <= N <= the grid's values (usage errors exit 2).
+fn parse_shard(s: &str, values: usize) -> Result<(usize, usize), ExitCode> {
+    let parsed = s.split_once('/').and_then(|(k, n)| {
+        Some((
+            k.trim().parse::<usize>().ok()?,
+            n.trim().parse::<usize>().ok()?,
+        ))
+    });
+    match parsed {
+        Some((k, n)) if k >= 1 && k <= n && n <= values => Ok((k, n)),
+        Some((_, n)) if n > values => Err(usage(&format!(
+            "--shard {s}: the sweep has {values} values, so at most {values} shares"
+        ))),
+        _ => Err(usage(&format!(
+            "--shard takes K/N with 1 <= K <= N, e.g. --shard 2/8, got `{s}`"
+        ))),
+    }
+}
+
+/// What every share of one sweep must agree on: the model's text (hashed) and the options
+/// of the analysis.
+fn describe_run(a: &StabilityArgs, text: &str) -> String {
+    // FNV-1a: a fingerprint, not a defence against forgery.
+    let hash = text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    format!(
+        "model {hash:016x}; --sweep {}; --set {:?}; --method {:?}; --period {:?}; --monodromy {:?}; --modes {:?}; --signals {:?}; --window {:?}; --samples {}",
+        a.sweep,
+        a.set,
+        a.method.name(),
+        a.period,
+        a.monodromy.name(),
+        a.modes,
+        a.signals,
+        a.window,
+        a.samples
+    )
 }
 
 /// How often the CSV is rewritten while the grid runs.
@@ -337,7 +445,7 @@ fn signals(a: &StabilityArgs, c: &Compiled, methods: &[Method]) -> Result<Vec<St
 }
 
 /// The columns of a reference CSV as lines against its first column.
-fn reference_series(path: &str) -> Result<Vec<Series>, ExitCode> {
+pub(super) fn reference_series(path: &str) -> Result<Vec<Series>, ExitCode> {
     let text =
         std::fs::read_to_string(path).map_err(|e| usage(&format!("cannot read `{path}`: {e}")))?;
     let (header, rows) =
@@ -356,7 +464,7 @@ fn reference_series(path: &str) -> Result<Vec<Series>, ExitCode> {
         .collect())
 }
 
-fn print_report(s: &sweep::Sweep) {
+pub(super) fn print_report(s: &sweep::Sweep) {
     say(&format!(
         "{:>12}  {:>8}  {:>12}  {:>12}  {:>12}  {:>8}",
         s.param, "method", "max Re s", "min damping", "its freq", "cpu s"

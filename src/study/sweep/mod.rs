@@ -12,6 +12,7 @@
 
 mod point;
 mod range;
+pub mod share;
 mod tracks;
 
 pub use point::{default_signals, rotor_period, PeriodError, PointError};
@@ -189,6 +190,26 @@ pub fn sweep_streaming<E: Display>(
         };
     };
     let brackets = brackets(spec, &points, primary);
+    let (edges, refinements, notes) = refine_edges(spec, &brackets, primary, compile, tick);
+    Sweep {
+        param: spec.param.clone(),
+        points,
+        refinements,
+        edges,
+        threshold: spec.threshold,
+        notes,
+    }
+}
+
+/// Each bracket bisected (in parallel): the edges, the evaluations and the notes of
+/// bisections stopped early, edges and evaluations by value.
+fn refine_edges<E: Display>(
+    spec: &SweepSpec,
+    brackets: &[Bracket],
+    primary: Method,
+    compile: &CompileWith<E>,
+    tick: &(dyn Fn(Tick) + Sync),
+) -> (Vec<Edge>, Vec<Point>, Vec<String>) {
     tick(Tick::Planned(brackets.len() * spec.refine));
     let refined = parallel(brackets.len(), |k| {
         bisect(spec, brackets[k], primary, compile, tick)
@@ -203,14 +224,7 @@ pub fn sweep_streaming<E: Display>(
     }
     edges.sort_by(|a, b| a.value.total_cmp(&b.value));
     refinements.sort_by(|a, b| a.value.total_cmp(&b.value));
-    Sweep {
-        param: spec.param.clone(),
-        points,
-        refinements,
-        edges,
-        threshold: spec.threshold,
-        notes,
-    }
+    (edges, refinements, notes)
 }
 
 /// Every value with every method, in parallel; `rows` gets the finished run from the start.

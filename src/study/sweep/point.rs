@@ -37,6 +37,8 @@ pub enum PointError {
     NoPole { signals: usize, from: f64, to: f64 },
     /// The worker thread panicked.
     Internal,
+    /// A failure read back from a sweep's share (`mbd merge`): its line.
+    Shared(String),
 }
 
 impl PointError {
@@ -51,7 +53,7 @@ impl PointError {
 impl fmt::Display for PointError {
     fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
         match self {
-            PointError::Compile(m) | PointError::Output(m) => {
+            PointError::Compile(m) | PointError::Output(m) | PointError::Shared(m) => {
                 write!(f, "{m}")
             }
             PointError::Period(e) => write!(f, "{e}"),
