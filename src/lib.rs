@@ -14,6 +14,7 @@
 pub mod channels;
 pub mod diagnostics;
 pub mod lint;
+pub mod loader;
 pub mod lower;
 pub mod model;
 pub mod output;

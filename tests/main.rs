@@ -25,6 +25,7 @@ mod modes;
 mod newton;
 mod outputs;
 mod pendulum;
+mod python;
 mod redundant;
 mod reference;
 mod rigid;

@@ -7,7 +7,6 @@
 
 pub mod check;
 pub mod explain;
-mod loader;
 pub mod merge;
 pub mod modes;
 pub mod plot;
@@ -18,8 +17,8 @@ pub mod study;
 mod swept;
 
 use clap::ValueEnum;
-use loader::FsLoader;
 use mbd::diagnostics::{render_human, render_json, summarize, Diagnostic, SHOWN_PER_CODE};
+use mbd::loader::FsLoader;
 use mbd::settings::Request;
 use mbd::source::SourceMap;
 use mbd::study::CompileError;

@@ -1,12 +1,19 @@
-//! Where `use`d modules come from: the file system.
+//! Where `use`d modules come from at the edges (the command line, the Python package): the
+//! file system. The compiler itself reads no file; it asks a [`crate::model::Loader`].
 
 /// Finds `use`d modules next to the importing file, then in the directories of MBD_PATH.
-pub(super) struct FsLoader {
+pub struct FsLoader {
     search: Vec<std::path::PathBuf>,
 }
 
+impl Default for FsLoader {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
 impl FsLoader {
-    pub(super) fn new() -> FsLoader {
+    pub fn new() -> FsLoader {
         let search = std::env::var_os("MBD_PATH")
             .map(|p| std::env::split_paths(&p).collect())
             .unwrap_or_default();
@@ -14,9 +21,12 @@ impl FsLoader {
     }
 }
 
-impl mbd::model::Loader for FsLoader {
-    fn load(&self, request: &mbd::model::LoadRequest) -> Result<(String, String), Option<String>> {
-        use mbd::model::LoadRequest;
+impl crate::model::Loader for FsLoader {
+    fn load(
+        &self,
+        request: &crate::model::LoadRequest,
+    ) -> Result<(String, String), Option<String>> {
+        use crate::model::LoadRequest;
         let (candidates, from): (Vec<std::path::PathBuf>, &str) = match request {
             LoadRequest::Module { path, from } => {
                 let mut p = std::path::PathBuf::new();

@@ -1,0 +1,665 @@
+//! `mbd._mbd`: the Python package's extension. Plain data in and out (texts, numbers, bytes
+//! of f64, JSON of diagnostics); the package `mbd` (`python/mbd/__init__.py`) builds the typed
+//! API on it. Every analysis compiles the model from its text in the call, with the GIL
+//! released, on a worker thread that the calling thread watches for Ctrl-C: on a
+//! KeyboardInterrupt it stops the run before its next step (as the CLI's Ctrl-C does), waits
+//! for it and raises.
+
+use mbd::diagnostics::{render_json, Diagnostic};
+use mbd::loader::FsLoader;
+use mbd::settings::{Method, NewtonMode, Request, Rotations, Start};
+use mbd::solve::floquet::Monodromy;
+use mbd::study::sweep::{self, share, SweepSpec};
+use mbd::{CompileFailure, Compiled};
+use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList};
+use std::sync::mpsc;
+use std::time::Duration;
+
+/// How often the waiting thread looks for Ctrl-C.
+const WATCH: Duration = Duration::from_millis(50);
+
+/// Runs `work` with the GIL released on a worker thread; a KeyboardInterrupt (or any signal
+/// handler's exception) stops mbd's runs, waits for `work` to return, and is raised.
+fn interruptible<T: Send>(py: Python<'_>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    py.detach(|| {
+        std::thread::scope(|s| {
+            let (tx, rx) = mpsc::channel();
+            let worker = std::thread::Builder::new()
+                .stack_size(64 << 20)
+                .spawn_scoped(s, move || {
+                    let _ = tx.send(work());
+                })
+                .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
+            let mut signal: Option<PyErr> = None;
+            let result = loop {
+                match rx.recv_timeout(WATCH) {
+                    Ok(r) => break Some(r),
+                    Err(mpsc::RecvTimeoutError::Disconnected) => break None,
+                    Err(mpsc::RecvTimeoutError::Timeout) => {
+                        if signal.is_none() {
+                            if let Err(e) = Python::attach(|py| py.check_signals()) {
+                                mbd::solve::interrupt();
+                                signal = Some(e);
+                            }
+                        }
+                    }
+                }
+            };
+            let _ = worker.join();
+            if let Some(e) = signal {
+                mbd::solve::clear_interrupt();
+                return Err(e);
+            }
+            result.ok_or_else(|| PyRuntimeError::new_err("mbd stopped on an internal error"))
+        })
+    })
+}
+
+/// The command line's request from the keywords of `run`, `modes` and `stability`.
+fn request(solve: Option<&Bound<'_, PyDict>>) -> PyResult<Request> {
+    let mut r = Request::default();
+    let Some(d) = solve else { return Ok(r) };
+    fn named<T: Copy>(what: &str, v: &str, table: &[(&'static str, T)]) -> PyResult<T> {
+        let v = v.replace('_', "-");
+        table
+            .iter()
+            .find(|(n, _)| n.replace('_', "-") == v)
+            .map(|(_, m)| *m)
+            .ok_or_else(|| {
+                let names: Vec<&str> = table.iter().map(|(n, _)| *n).collect();
+                PyValueError::new_err(format!(
+                    "{what} must be one of {}, got `{v}`",
+                    names.join(", ")
+                ))
+            })
+    }
+    for (k, v) in d.iter() {
+        let key: String = k.extract()?;
+        if v.is_none() {
+            continue;
+        }
+        match key.as_str() {
+            "integrator" => {
+                r.method = Some(named::<Method>(&key, &v.extract::<String>()?, &Method::FLAGS)?)
+            }
+            "rotations" => {
+                r.rotations = Some(named::<Rotations>(&key, &v.extract::<String>()?, &Rotations::FLAGS)?)
+            }
+            "start" => r.start = Some(named::<Start>(&key, &v.extract::<String>()?, &Start::FLAGS)?),
+            "newton" => {
+                r.newton = Some(named::<NewtonMode>(&key, &v.extract::<String>()?, &NewtonMode::FLAGS)?)
+            }
+            "alpha" => r.alpha = Some(v.extract()?),
+            "rho_inf" => r.rho_inf = Some(v.extract()?),
+            "dt" => r.dt = Some(v.extract()?),
+            "until" => r.until = Some(v.extract()?),
+            "steps" => r.steps = Some(v.extract()?),
+            "every" => r.every = Some(v.extract()?),
+            "tolerance" => r.tolerance = Some(v.extract()?),
+            "max_iterations" => r.max_iterations = Some(v.extract()?),
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "unknown solver setting `{other}`: the settings are integrator, alpha, rho_inf, rotations, dt, steps, until, every, start, tolerance, max_iterations, newton"
+                )))
+            }
+        }
+    }
+    if let Some(bad) = r.check().first() {
+        let m = bad.flag_message();
+        return Err(PyValueError::new_err(
+            m.strip_prefix("--").unwrap_or(&m).replace('-', "_"),
+        ));
+    }
+    Ok(r)
+}
+
+/// The model text compiled, or its diagnostics as JSON.
+fn compile(name: &str, text: &str, sets: &[String], r: Request) -> Result<Compiled, String> {
+    mbd::compile_with(name, text, sets, r, &FsLoader::new()).map_err(
+        |CompileFailure {
+             sources,
+             diagnostics,
+         }| render_json(&diagnostics, &sources),
+    )
+}
+
+/// Compiles a model: `(ok, diagnostics JSON, info)`; with `lint` the sizing lint's warnings
+/// too. `info`: the model's name, title, output channels, params (name, SI value or None) and
+/// the resolved step and end time.
+#[pyfunction]
+#[pyo3(signature = (name, text, sets, lint=true))]
+fn check(
+    py: Python<'_>,
+    name: String,
+    text: String,
+    sets: Vec<String>,
+    lint: bool,
+) -> PyResult<(bool, String, Py<PyDict>)> {
+    let out = interruptible(py, || {
+        match compile(&name, &text, &sets, Request::default()) {
+            Err(json) => (false, json, None),
+            Ok(c) => {
+                let mut all: Vec<Diagnostic> = c.warnings.clone();
+                if lint {
+                    let l = mbd::lint(
+                        &c,
+                        &name,
+                        &text,
+                        &sets,
+                        Request::default(),
+                        &FsLoader::new(),
+                    );
+                    all.extend(l.diagnostics);
+                }
+                let params: Vec<(String, Option<f64>)> = (c.model.params.iter())
+                    .map(|(n, v)| {
+                        let x = match v {
+                            mbd::model::Value::Scalar { value, .. } => Some(*value),
+                            _ => None,
+                        };
+                        (n.clone(), x)
+                    })
+                    .collect();
+                let info = (
+                    c.model.name.clone(),
+                    c.model.title.clone(),
+                    c.model
+                        .outputs
+                        .iter()
+                        .map(|o| o.column.clone())
+                        .collect::<Vec<_>>(),
+                    params,
+                    (
+                        c.settings.dt,
+                        c.settings.dt * c.settings.steps as f64,
+                        c.settings.steps,
+                    ),
+                );
+                (true, render_json(&all, &c.sources), Some(info))
+            }
+        }
+    })?;
+    let d = PyDict::new(py);
+    if let Some((model, title, channels, params, (dt, until, steps))) = out.2 {
+        d.set_item("name", model)?;
+        d.set_item("title", title)?;
+        d.set_item("channels", channels)?;
+        d.set_item("params", params)?;
+        d.set_item("dt", dt)?;
+        d.set_item("until", until)?;
+        d.set_item("steps", steps)?;
+    }
+    Ok((out.0, out.1, d.unbind()))
+}
+
+/// A run's table and record. On a compile error: `{"errors": JSON}`. Else `header`, `data`
+/// (row-major f64 bytes, each value the one the CLI's CSV holds), `rows`, `stats`, `cpu_s`,
+/// `warnings` (JSON), and on a runtime failure `failure` (JSON of its diagnostic) with
+/// `failure_t`, `failure_step`, `failure_entity`.
+#[pyfunction]
+#[pyo3(signature = (name, text, sets, solve=None))]
+fn run(
+    py: Python<'_>,
+    name: String,
+    text: String,
+    sets: Vec<String>,
+    solve: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Py<PyDict>> {
+    let r = request(solve)?;
+    let out = interruptible(py, move || -> Result<Ran, String> {
+        let c = compile(&name, &text, &sets, r)?;
+        let mut csv = Vec::new();
+        let cpu = mbd::study::thread_cpu_seconds();
+        let ran = mbd::run(&c, &mut csv);
+        let cpu_s = mbd::study::thread_cpu_seconds() - cpu;
+        let (header, rows) = mbd::output::read_csv(&String::from_utf8_lossy(&csv))
+            .unwrap_or_else(|_| (Vec::new(), Vec::new()));
+        let data: Vec<u8> = rows
+            .iter()
+            .flatten()
+            .flat_map(|x| x.to_le_bytes())
+            .collect();
+        let mut done = Ran {
+            header,
+            rows: rows.len(),
+            data,
+            cpu_s,
+            stats: None,
+            warnings: String::new(),
+            failure: None,
+        };
+        match ran {
+            Ok(report) => {
+                let s = report.stats;
+                done.stats = Some([
+                    ("steps", s.steps as f64),
+                    ("newton_iterations", s.newton_iterations as f64),
+                    ("halvings", s.halvings as f64),
+                    ("factorizations", s.factorizations as f64),
+                    ("max_constraint_violation", s.max_constraint_violation),
+                ]);
+                done.warnings = render_json(&report.warnings, &c.sources);
+            }
+            Err(f) => {
+                done.warnings = render_json(&f.warnings, &c.sources);
+                let entity = (f.failure.as_ref())
+                    .and_then(|x| x.entity)
+                    .and_then(|e| c.lowered.system.entities.get(e))
+                    .map(|e| format!("{} {}", e.kind, e.name));
+                let (t, step) = f.failure.as_ref().map_or((f64::NAN, 0), |x| (x.t, x.step));
+                done.failure = Some((render_json(&[f.diagnostic], &c.sources), t, step, entity));
+            }
+        }
+        Ok(done)
+    })?;
+    let d = PyDict::new(py);
+    match out {
+        Err(json) => d.set_item("errors", json)?,
+        Ok(r) => {
+            d.set_item("header", r.header)?;
+            d.set_item("rows", r.rows)?;
+            d.set_item("data", PyBytes::new(py, &r.data))?;
+            d.set_item("cpu_s", r.cpu_s)?;
+            d.set_item("warnings", r.warnings)?;
+            if let Some(stats) = r.stats {
+                let s = PyDict::new(py);
+                for (k, v) in stats {
+                    s.set_item(k, v)?;
+                }
+                d.set_item("stats", s)?;
+            }
+            if let Some((json, t, step, entity)) = r.failure {
+                d.set_item("failure", json)?;
+                d.set_item("failure_t", t)?;
+                d.set_item("failure_step", step)?;
+                d.set_item("failure_entity", entity)?;
+            }
+        }
+    }
+    Ok(d.unbind())
+}
+
+struct Ran {
+    header: Vec<String>,
+    rows: usize,
+    data: Vec<u8>,
+    cpu_s: f64,
+    stats: Option<[(&'static str, f64); 5]>,
+    warnings: String,
+    failure: Option<(String, f64, usize, Option<String>)>,
+}
+
+/// The modes about the initial state: `(ok, modes CSV or diagnostics JSON, shapes CSV)`, the
+/// tables of `mbd modes -o` and `--shapes`.
+#[pyfunction]
+#[pyo3(signature = (name, text, sets, frozen=false, count=None, solve=None))]
+fn modes(
+    py: Python<'_>,
+    name: String,
+    text: String,
+    sets: Vec<String>,
+    frozen: bool,
+    count: Option<usize>,
+    solve: Option<&Bound<'_, PyDict>>,
+) -> PyResult<(bool, String, String)> {
+    let r = request(solve)?;
+    interruptible(py, move || {
+        let c = match compile(&name, &text, &sets, r) {
+            Ok(c) => c,
+            Err(json) => return (false, json, String::new()),
+        };
+        match mbd::modes(&c, frozen) {
+            Err(d) => (false, render_json(&[d], &c.sources), String::new()),
+            Ok(m) => {
+                let n = count.unwrap_or(m.modes.len());
+                let (mut table, mut shapes) = (Vec::new(), Vec::new());
+                let written = mbd::write_modes(&m, n, &mut table)
+                    .and_then(|()| mbd::write_shapes(&c, &m, n, &mut shapes));
+                match written {
+                    Ok(()) => (
+                        true,
+                        String::from_utf8_lossy(&table).into_owned(),
+                        String::from_utf8_lossy(&shapes).into_owned(),
+                    ),
+                    Err(e) => (false, format!("[{{\"message\": \"{e}\"}}]"), String::new()),
+                }
+            }
+        }
+    })
+}
+
+/// The stability analysis's options from `mbd.Model.stability`'s keywords.
+fn spec(param: String, values: Vec<f64>, o: &Bound<'_, PyDict>) -> PyResult<SweepSpec> {
+    let get = |k: &str| -> PyResult<Option<Bound<'_, PyAny>>> {
+        Ok(o.get_item(k)?.filter(|v| !v.is_none()))
+    };
+    let method: String = get("method")?.map_or(Ok("floquet".to_string()), |v| v.extract())?;
+    let methods = match method.as_str() {
+        "floquet" => vec![sweep::Method::Floquet],
+        "prony" => vec![sweep::Method::Prony],
+        "both" => vec![sweep::Method::Floquet, sweep::Method::Prony],
+        m => {
+            return Err(PyValueError::new_err(format!(
+                "method must be floquet, prony or both, got `{m}`"
+            )))
+        }
+    };
+    let monodromy = match (
+        get("modes")?.map(|v| v.extract::<usize>()).transpose()?,
+        get("monodromy")?,
+    ) {
+        (Some(0), _) => return Err(PyValueError::new_err("modes must be at least 1")),
+        (Some(k), _) => Monodromy::Krylov(k),
+        (None, None) => Monodromy::Tangent,
+        (None, Some(v)) => match v.extract::<String>()?.as_str() {
+            "tangent" => Monodromy::Tangent,
+            "runs" => Monodromy::Runs,
+            m => {
+                return Err(PyValueError::new_err(format!(
+                    "monodromy must be tangent or runs, got `{m}`"
+                )))
+            }
+        },
+    };
+    if values.is_empty() || values.iter().any(|v| !v.is_finite()) {
+        return Err(PyValueError::new_err(format!(
+            "the values of `{param}` must be finite numbers, at least one"
+        )));
+    }
+    Ok(SweepSpec {
+        param,
+        values,
+        methods,
+        period: get("period")?.map(|v| v.extract()).transpose()?,
+        monodromy,
+        signals: get("signals")?
+            .map(|v| v.extract())
+            .transpose()?
+            .unwrap_or_default(),
+        window: get("window")?.map(|v| v.extract()).transpose()?,
+        samples: get("samples")?.map_or(Ok(300), |v| v.extract())?,
+        threshold: get("threshold")?.map_or(Ok(1e-2), |v| v.extract())?,
+        refine: get("refine")?.map_or(Ok(6), |v| v.extract())?,
+    })
+}
+
+/// What a sweep needs of the model, checked on the first value (as `mbd stability` checks
+/// it): it compiles, has the param, the channels Prony fits, and a period for Floquet.
+fn precheck(name: &str, text: &str, sets: &[String], s: &SweepSpec) -> Result<(), String> {
+    let mut first = sets.to_vec();
+    first.push(format!("{}={}", s.param, s.values[0]));
+    let c = compile(name, text, &first, Request::default())?;
+    let value_error =
+        |m: String| serde_json::json!([{ "code": "usage", "message": m }]).to_string();
+    if !c.model.params.iter().any(|(n, _)| *n == s.param) {
+        return Err(value_error(format!(
+            "model `{}` has no param `{}`",
+            c.model.name, s.param
+        )));
+    }
+    let channels: Vec<&str> = c.model.outputs.iter().map(|o| o.column.as_str()).collect();
+    if let Some(bad) = s.signals.iter().find(|x| !channels.contains(&x.as_str())) {
+        return Err(value_error(format!(
+            "model `{}` has no output channel `{bad}`",
+            c.model.name
+        )));
+    }
+    if s.methods.contains(&sweep::Method::Floquet) && s.period.is_none() {
+        sweep::rotor_period(&c).map_err(|e| value_error(e.to_string()))?;
+    }
+    Ok(())
+}
+
+/// A stability sweep: `(ok, CSV or diagnostics JSON, report)`, the CSV of `mbd stability -o`;
+/// `report`: edges `(value, lo, hi, onset)`, unstable ranges, notes, failed points.
+#[pyfunction]
+fn stability(
+    py: Python<'_>,
+    name: String,
+    text: String,
+    sets: Vec<String>,
+    param: String,
+    values: Vec<f64>,
+    options: &Bound<'_, PyDict>,
+) -> PyResult<(bool, String, Py<PyDict>)> {
+    let s = spec(param, values, options)?;
+    let out = interruptible(py, move || {
+        precheck(&name, &text, &sets, &s)?;
+        let compile = |extra: &[String]| {
+            let mut all = sets.clone();
+            all.extend_from_slice(extra);
+            mbd::compile_with(&name, &text, &all, Request::default(), &FsLoader::new())
+                .map_err(|f| mbd::study::CompileError::of(&f))
+        };
+        let result = sweep::sweep(&s, &compile, &|_| {});
+        Ok::<_, String>(result)
+    })?;
+    match out {
+        Err(json) => Ok((false, json, PyDict::new(py).unbind())),
+        Ok(result) => {
+            let (csv, report) = tables(py, &result)?;
+            Ok((true, csv, report))
+        }
+    }
+}
+
+/// A sweep's CSV and report (see [`stability`]).
+fn tables(py: Python<'_>, result: &sweep::Sweep) -> PyResult<(String, Py<PyDict>)> {
+    let mut csv = Vec::new();
+    result
+        .write_csv(&mut csv)
+        .map_err(|e| PyRuntimeError::new_err(e.to_string()))?;
+    let d = PyDict::new(py);
+    let edges: Vec<(f64, f64, f64, bool)> = (result.edges.iter())
+        .map(|e| (e.value, e.bracket.0, e.bracket.1, e.onset))
+        .collect();
+    d.set_item("edges", edges)?;
+    d.set_item("unstable", result.unstable_ranges())?;
+    d.set_item("notes", PyList::new(py, &result.notes)?)?;
+    let failed: Vec<(f64, String)> = (result.points.iter().chain(&result.refinements))
+        .filter_map(|p| p.failure.as_ref().map(|f| (p.value, f.to_string())))
+        .collect();
+    d.set_item("failed", failed)?;
+    Ok((String::from_utf8_lossy(&csv).into_owned(), d.unbind()))
+}
+
+/// Share `k` of `n` of a stability sweep, as the JSON that `mbd stability --shard K/N`
+/// writes: `(ok, share JSON or diagnostics JSON)`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn stability_share(
+    py: Python<'_>,
+    name: String,
+    text: String,
+    sets: Vec<String>,
+    param: String,
+    values: Vec<f64>,
+    options: &Bound<'_, PyDict>,
+    k: usize,
+    n: usize,
+) -> PyResult<(bool, String)> {
+    let s = spec(param, values, options)?;
+    if !(1 <= k && k <= n && n <= s.values.len()) {
+        return Err(PyValueError::new_err(format!(
+            "share {k} of {n}: need 1 <= k <= n <= {} (the values)",
+            s.values.len()
+        )));
+    }
+    let out = interruptible(py, move || {
+        precheck(&name, &text, &sets, &s)?;
+        let compile = |extra: &[String]| {
+            let mut all = sets.clone();
+            all.extend_from_slice(extra);
+            mbd::compile_with(&name, &text, &all, Request::default(), &FsLoader::new())
+                .map_err(|f| mbd::study::CompileError::of(&f))
+        };
+        let run = format!("{text}\u{0}{sets:?}\u{0}{:?}", s.methods);
+        let share = share::sweep_share(&s, (k, n), &compile, &|_| {}, (&run, "", &s.param));
+        serde_json::to_string(&share).map_err(|e| e.to_string())
+    })?;
+    Ok(match out {
+        Ok(json) => (true, json),
+        Err(json) => (false, json),
+    })
+}
+
+/// The shares joined (`mbd merge`): the sweep's CSV and report, as [`stability`] gives them.
+#[pyfunction]
+fn merge(py: Python<'_>, shares: Vec<String>) -> PyResult<(String, Py<PyDict>)> {
+    let parsed = shares
+        .iter()
+        .map(|s| serde_json::from_str::<share::Share>(s))
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| PyValueError::new_err(format!("not a share of a sweep: {e}")))?;
+    let (result, _) = share::merge(parsed).map_err(|e| PyValueError::new_err(e.to_string()))?;
+    tables(py, &result)
+}
+
+/// What `mbd study` takes, as texts in the command line's syntax (lists comma-separated).
+#[derive(FromPyObject)]
+#[pyo3(from_item_all)]
+struct StudyArgs {
+    channel: String,
+    integrators: Option<String>,
+    alphas: Option<String>,
+    steps: Option<String>,
+    dt: Option<String>,
+    until: Option<f64>,
+    at: Option<f64>,
+    reference: Option<String>,
+}
+
+/// A study (`mbd study`): `(ok, CSV or diagnostics JSON)`, the CSV of `mbd study -o`: a
+/// convergence study with `integrators` (error and CPU per run against the reference), or a
+/// stability study with `alphas` (each run's onset of instability).
+#[pyfunction]
+fn study(
+    py: Python<'_>,
+    name: String,
+    text: String,
+    sets: Vec<String>,
+    args: StudyArgs,
+) -> PyResult<(bool, String)> {
+    use mbd::study::{convergence, stability, IntegratorItem, StepList};
+    let bad = |e: &dyn std::fmt::Display| PyValueError::new_err(e.to_string());
+    let steps = match (&args.steps, &args.dt) {
+        (Some(_), Some(_)) => return Err(PyValueError::new_err("give steps or dt, not both")),
+        (Some(s), None) => Some(StepList::parse_counts(s).map_err(|e| bad(&e))?),
+        (None, Some(d)) => Some(StepList::parse_dt(d).map_err(|e| bad(&e))?),
+        (None, None) => None,
+    };
+    let kind =
+        match (&args.integrators, &args.alphas) {
+            (Some(i), None) => Ok(IntegratorItem::parse_list(i).map_err(|e| bad(&e))?),
+            (None, Some(a)) => Err(mbd::study::parse_alphas(a).map_err(|e| bad(&e))?),
+            _ => return Err(PyValueError::new_err(
+                "give integrators (a convergence study) or alphas (a stability study), one of them",
+            )),
+        };
+    if kind.is_ok() && steps.is_none() {
+        return Err(PyValueError::new_err(
+            "a convergence study needs the steps: steps=[100, 200, 400] or dt=[...]",
+        ));
+    }
+    let out = interruptible(py, move || -> Result<Result<String, String>, String> {
+        let base = Request {
+            every: Some(1),
+            until: args.until,
+            ..Request::default()
+        };
+        let c = compile(&name, &text, &sets, base.clone())?;
+        let usage = |m: String| serde_json::json!([{ "code": "usage", "message": m }]).to_string();
+        if !c.model.outputs.iter().any(|o| o.column == args.channel) {
+            return Err(usage(format!(
+                "model `{}` has no output channel `{}`",
+                c.model.name, args.channel
+            )));
+        }
+        let until = c.settings.until;
+        let counts = match &steps {
+            Some(s) => s.counts(until).map_err(|e| usage(e.to_string()))?,
+            None => vec![c.settings.steps],
+        };
+        let compile = |r: &Request| {
+            mbd::compile_with(&name, &text, &sets, r.clone(), &FsLoader::new())
+                .map_err(|f| mbd::study::CompileError::of(&f))
+        };
+        let mut csv = Vec::new();
+        let written = match kind {
+            Ok(integrators) => {
+                let reference = match args.reference.as_deref() {
+                    None | Some("finest") => convergence::ReferenceSpec::Finest,
+                    Some("exact") => {
+                        match c.model.exact.iter().find(|e| e.column == args.channel) {
+                            Some(e) => convergence::ReferenceSpec::Exact(e.f.clone()),
+                            None => {
+                                return Err(usage(format!(
+                                    "reference exact: the model declares no exact solution of `{}`",
+                                    args.channel
+                                )))
+                            }
+                        }
+                    }
+                    Some(file) => {
+                        let t = std::fs::read_to_string(file)
+                            .map_err(|e| usage(format!("cannot read `{file}`: {e}")))?;
+                        let (h, rows) = mbd::output::read_csv(&t)
+                            .map_err(|e| usage(format!("`{file}`: {e}")))?;
+                        let s = mbd::study::compare::Samples::from_table(&h, &rows, &args.channel)
+                            .map_err(|e| usage(format!("`{file}`: {e}")))?;
+                        convergence::ReferenceSpec::Samples(s)
+                    }
+                };
+                let spec = convergence::ConvergenceSpec {
+                    channel: args.channel.clone(),
+                    at: args.at,
+                    integrators,
+                    steps: counts,
+                    until,
+                    reference,
+                };
+                convergence::convergence(&spec, &base, &compile).write_csv(&mut csv)
+            }
+            Err(alphas) => {
+                let spec = stability::StabilitySpec {
+                    channel: args.channel.clone(),
+                    alphas,
+                    steps: counts,
+                    until,
+                    detector: stability::Detector::default(),
+                };
+                stability::write_csv(&stability::stability(&spec, &base, &compile), &mut csv)
+            }
+        };
+        Ok(written
+            .map(|()| String::from_utf8_lossy(&csv).into_owned())
+            .map_err(|e| e.to_string()))
+    })?;
+    match out {
+        Ok(Ok(csv)) => Ok((true, csv)),
+        Ok(Err(e)) => Err(PyRuntimeError::new_err(e)),
+        Err(json) => Ok((false, json)),
+    }
+}
+
+/// The values of `mbd stability --sweep NAME=START:STOP:STEP` (STOP included), exactly.
+#[pyfunction]
+fn grid(start: f64, stop: f64, step: f64) -> PyResult<Vec<f64>> {
+    sweep::grid(start, stop, step).map_err(|e| PyValueError::new_err(e.to_string()))
+}
+
+#[pymodule]
+fn _mbd(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(check, m)?)?;
+    m.add_function(wrap_pyfunction!(run, m)?)?;
+    m.add_function(wrap_pyfunction!(modes, m)?)?;
+    m.add_function(wrap_pyfunction!(stability, m)?)?;
+    m.add_function(wrap_pyfunction!(stability_share, m)?)?;
+    m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add_function(wrap_pyfunction!(grid, m)?)?;
+    m.add_function(wrap_pyfunction!(study, m)?)?;
+    m.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}
