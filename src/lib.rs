@@ -286,6 +286,22 @@ pub fn run_with_progress(
     out: &mut dyn Write,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<RunReport, RunFailure> {
+    run_observed(c, out, progress, None)
+}
+
+/// The model's 3-D scene (`mbd view`): its parts as shapes on anchors that move with the state.
+pub fn scene(c: &Compiled) -> runtime::scene::Scene {
+    lower::scene(&c.model)
+}
+
+/// [`run_with_progress`], calling `observe(state, values)` at every written row (the start
+/// included) with the row's channel values: what a 3-D view samples.
+pub fn run_observed(
+    c: &Compiled,
+    out: &mut dyn Write,
+    progress: &mut dyn FnMut(usize, usize),
+    mut observe: Option<&mut dyn FnMut(&runtime::State, &[f64])>,
+) -> Result<RunReport, RunFailure> {
     let set = &c.settings;
     let l = &c.lowered;
     let sys = &l.system;
@@ -347,11 +363,21 @@ pub fn run_with_progress(
     }
     csv.row(sys, hht.state(), hht.augment())
         .map_err(|e| io_fail(e, 0))?;
+    let mut values = Vec::with_capacity(sys.channels.len());
+    let mut look = |st: &runtime::State, aug| {
+        if let Some(observe) = observe.as_mut() {
+            values.clear();
+            values.extend(sys.channels.iter().map(|ch| sys.probe(&ch.probe, st, aug)));
+            observe(st, &values);
+        }
+    };
+    look(hht.state(), hht.augment());
     let mut rows = 1;
     let ran = hht.run(|k, it| {
         progress(k, set.steps);
         if k % set.every == 0 || k == set.steps {
             csv.row(sys, it.state(), it.augment())?;
+            look(it.state(), it.augment());
             rows += 1;
         }
         Ok(())

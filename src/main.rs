@@ -39,6 +39,9 @@ enum Command {
     /// Join the shares of a stability sweep (`mbd stability --shard K/N`) into its CSV and chart.
     #[command(long_about = cli::merge::LONG_ABOUT)]
     Merge(cli::merge::MergeArgs),
+    /// The model in 3-D at t = 0: one HTML file that opens offline, or a glTF binary.
+    #[command(long_about = cli::view::LONG_ABOUT)]
+    View(cli::view::ViewArgs),
     /// Explain a diagnostic code, e.g. `mbd explain E0202`.
     Explain { code: String },
 }
@@ -66,6 +69,7 @@ fn main() -> ExitCode {
         Command::Study(args) => cli::study::study(args),
         Command::Stability(args) => cli::stability::stability(args),
         Command::Merge(args) => cli::merge::merge(args),
+        Command::View(args) => cli::view::view(args),
         Command::Explain { code } => cli::explain::explain(&code),
     };
     if mbd::solve::interrupted() {

@@ -15,6 +15,7 @@ pub mod run;
 pub mod stability;
 pub mod study;
 mod swept;
+pub mod view;
 
 use clap::ValueEnum;
 use mbd::diagnostics::{render_human, render_json, summarize, Diagnostic, SHOWN_PER_CODE};

@@ -3,6 +3,7 @@
 //! simulation fails (the rows before the failure are kept).
 
 use super::progress::Steps;
+use super::view::Recorder;
 use super::{compile_linted, read_as, report, sink, to_path, usage, Format, EXIT_RUNTIME};
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use mbd::settings::{Method, NewtonMode, Request, Rotations, Start};
@@ -15,6 +16,13 @@ pub struct RunArgs {
     /// Write the CSV here (default: standard output).
     #[arg(short = 'o', long = "output")]
     output: Option<String>,
+    /// Write an animated 3-D view of the run here: one HTML file that opens offline
+    /// (`mbd view --help`).
+    #[arg(long, value_name = "VIEW.html")]
+    view: Option<String>,
+    /// Write the run's scene and motion as a glTF 2.0 binary here.
+    #[arg(long, value_name = "OUT.glb")]
+    gltf: Option<String>,
     /// Override a param: NAME=VALUE, VALUE in SI units or with units (V0=5, V0=5m/s).
     #[arg(long = "set", value_name = "NAME=VALUE")]
     set: Vec<String>,
@@ -105,8 +113,27 @@ pub fn run(a: RunArgs) -> ExitCode {
     };
     let started = std::time::Instant::now();
     let mut progress = Steps::new(started);
-    let result = mbd::run_with_progress(&c, &mut sink, &mut |k, n| progress.update(k, n));
+    let wants_view = a.view.is_some() || a.gltf.is_some();
+    let rows = c.settings.steps / c.settings.every.max(1) + 2;
+    let mut recorder = wants_view.then(|| Recorder::new(&c, rows));
+    let mut observe = |st: &mbd::runtime::State, v: &[f64]| {
+        if let Some(r) = recorder.as_mut() {
+            r.sample(st, v);
+        }
+    };
+    let result = mbd::run_observed(
+        &c,
+        &mut sink,
+        &mut |k, n| progress.update(k, n),
+        wants_view.then_some(&mut observe as &mut dyn FnMut(&mbd::runtime::State, &[f64])),
+    );
     progress.finish();
+    if let Some(r) = recorder.as_mut() {
+        // Written after a failure too: the view ends where the run stopped.
+        if let Err(code) = r.write(&c, a.view.as_deref(), a.gltf.as_deref()) {
+            return code;
+        }
+    }
     match result {
         Ok(r) => {
             report(&r.warnings, &c.sources, format);

@@ -7,6 +7,9 @@
 mod beams;
 mod joints;
 mod redundant;
+mod scene;
+
+pub use scene::scene;
 
 use crate::model::dofs::Unknown;
 use crate::model::{

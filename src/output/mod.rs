@@ -5,10 +5,12 @@
 //! Rows are written as they come, so a failed run keeps every row computed before the failure.
 
 pub mod charts;
+pub mod gltf;
 mod guides;
 mod legend;
 pub mod raster;
 pub mod ticks;
+pub mod view;
 
 use crate::runtime::{Augment, State, System};
 use std::io::{self, Write};

@@ -18,6 +18,7 @@ mod forces;
 pub mod joints;
 mod probes;
 pub mod rotation;
+pub mod scene;
 pub mod timefn;
 
 pub use assembly::{Assembler, Pattern};

@@ -1,0 +1,189 @@
+//! Issue 25: the 3-D view. The HTML page's data (the scene's shapes, the sampled poses and
+//! the channels' histories) against the run's CSV; the glTF binary read back and validated by
+//! the `gltf` crate (structure, accessor bounds, the animation against the run).
+
+use crate::cli::{code, mbd, stderr, temp};
+use base64::Engine;
+
+fn floats(b64: &serde_json::Value) -> Vec<f32> {
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(b64.as_str().expect("base64 text"))
+        .expect("base64");
+    bytes
+        .chunks(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect()
+}
+
+/// The JSON the page carries.
+fn page_data(html: &str) -> serde_json::Value {
+    let tag = "<script id=\"mbd-data\" type=\"application/json\">";
+    let start = html.find(tag).expect("data") + tag.len();
+    let end = start + html[start..].find("</script>").expect("end of data");
+    serde_json::from_str(&html[start..end].replace("<\\/", "</")).expect("JSON")
+}
+
+#[test]
+fn a_run_view_follows_the_pendulum_as_its_csv_says() {
+    let (html, glb, csv) = (temp("p.html", ""), temp("p.glb", ""), temp("p.csv", ""));
+    let o = mbd(&[
+        "run",
+        "models/pendulum.mbd",
+        "--view",
+        html.to_str().expect("path"),
+        "--gltf",
+        glb.to_str().expect("path"),
+        "-o",
+        csv.to_str().expect("path"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let text = std::fs::read_to_string(&html).expect("html");
+    assert!(text.starts_with("<!DOCTYPE html>"));
+    // Self-contained: no address to fetch.
+    assert!(!text.contains("src=\"http") && !text.contains("href=\"http"));
+    let d = page_data(&text);
+    let (_, rows) =
+        mbd::output::read_csv(&std::fs::read_to_string(&csv).expect("csv")).expect("parse");
+    let t: Vec<f64> = serde_json::from_value(d["t"].clone()).expect("t");
+    // 201 rows, all kept (fewer than view::MAX_FRAMES).
+    assert_eq!(t.len(), rows.len());
+    let shapes = d["shapes"].as_array().expect("shapes");
+    let bob = shapes
+        .iter()
+        .find(|s| s["name"] == "bob")
+        .expect("the bob's shape");
+    assert_eq!(bob["kind"], "point mass");
+    assert_eq!(bob["info"], "1 kg");
+    let link = shapes.iter().find(|s| s["name"] == "link").expect("link");
+    assert_eq!(link["kind"], "distance joint");
+    assert_eq!(link["look"]["type"], "link");
+    let anchors = d["anchors"].as_u64().expect("anchors") as usize;
+    let p = floats(&d["positions"]);
+    let q = floats(&d["rotations"]);
+    assert_eq!(p.len(), 3 * anchors * t.len());
+    assert_eq!(q.len(), 4 * anchors * t.len());
+    let a = bob["anchor"].as_u64().expect("anchor") as usize;
+    // The bob's anchor is where the CSV's x and y put it, to f32's rounding.
+    let mut worst = 0.0f64;
+    for (k, r) in rows.iter().enumerate() {
+        assert!((t[k] - r[0]).abs() <= 1e-12, "{} {}", t[k], r[0]);
+        let at = 3 * (k * anchors + a);
+        worst = worst
+            .max((p[at] as f64 - r[1]).abs())
+            .max((p[at + 1] as f64 - r[2]).abs());
+    }
+    assert!(worst < 1e-7, "{worst}");
+    // Each channel's history, per sample.
+    let hist = d["histories"].as_array().expect("histories");
+    assert_eq!(hist[0]["name"], "x");
+    assert_eq!(hist[0]["unit"], "m");
+    assert_eq!(hist[6]["name"], "tension");
+    assert_eq!(hist[6]["unit"], "N");
+    let tension = floats(&hist[6]["values"]);
+    assert_eq!(tension.len(), rows.len());
+    assert!(tension
+        .iter()
+        .zip(&rows)
+        .all(|(v, r)| (*v as f64 - r[7]).abs() <= 1e-6 * r[7].abs()));
+    // Unit quaternions.
+    assert!(q
+        .chunks(4)
+        .all(|c| (c.iter().map(|x| x * x).sum::<f32>() - 1.0).abs() < 1e-6));
+
+    // The glTF binary: valid, and the link's node follows the bob.
+    let bytes = std::fs::read(&glb).expect("glb");
+    let g = gltf::Gltf::from_slice(&bytes).expect("a valid glTF binary");
+    let blob = g.blob.as_deref().expect("binary chunk");
+    check_bounds(&g, blob);
+    let anim = g.animations().next().expect("an animation");
+    let link_node = g
+        .nodes()
+        .find(|n| n.name() == Some("link"))
+        .expect("link node");
+    let channel = anim
+        .channels()
+        .find(|c| {
+            c.target().node().index() == link_node.index()
+                && matches!(c.target().property(), gltf::animation::Property::Scale)
+        })
+        .expect("the link's scale");
+    let lengths = read(blob, &channel.sampler().output());
+    let times = read(blob, &channel.sampler().input());
+    assert_eq!(times.len(), rows.len());
+    // The link's length (the scale along its axis) is the rope's, 0.5 m.
+    for s in lengths.chunks(3) {
+        assert!((s[1] - 0.5).abs() < 1e-6, "{s:?}");
+    }
+}
+
+/// The floats of an accessor.
+fn read(blob: &[u8], a: &gltf::Accessor) -> Vec<f32> {
+    let v = a.view().expect("buffer view");
+    let at = v.offset() + a.offset();
+    let n = a.count() * a.dimensions().multiplicity();
+    (0..n)
+        .map(|i| {
+            let o = at + 4 * i;
+            f32::from_le_bytes([blob[o], blob[o + 1], blob[o + 2], blob[o + 3]])
+        })
+        .collect()
+}
+
+/// Every accessor's data lies within its declared min and max, which are attained.
+fn check_bounds(g: &gltf::Gltf, blob: &[u8]) {
+    for a in g.accessors() {
+        let width = a.dimensions().multiplicity();
+        let v = read(blob, &a);
+        let (Some(lo), Some(hi)) = (a.min(), a.max()) else {
+            panic!("accessor {} has no bounds", a.index());
+        };
+        let lo: Vec<f32> = serde_json::from_value(lo).expect("min");
+        let hi: Vec<f32> = serde_json::from_value(hi).expect("max");
+        for k in 0..width {
+            let col: Vec<f32> = v.iter().skip(k).step_by(width).copied().collect();
+            let (mn, mx) = col
+                .iter()
+                .fold((f32::INFINITY, f32::NEG_INFINITY), |(a, b), x| {
+                    (a.min(*x), b.max(*x))
+                });
+            assert_eq!((mn, mx), (lo[k], hi[k]), "accessor {}", a.index());
+        }
+    }
+}
+
+#[test]
+fn a_view_of_the_windmill_at_rest_and_its_gltf() {
+    let (html, glb) = (temp("w.html", ""), temp("w.glb", ""));
+    let o = mbd(&[
+        "view",
+        "models/windmill.mbd",
+        "-o",
+        html.to_str().expect("path"),
+        "--gltf",
+        glb.to_str().expect("path"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let d = page_data(&std::fs::read_to_string(&html).expect("html"));
+    assert_eq!(d["t"].as_array().map(Vec::len), Some(1));
+    let shapes = d["shapes"].as_array().expect("shapes");
+    let kinds = |k: &str| shapes.iter().filter(|s| s["kind"] == k).count();
+    // Four blades and their hub and tower top as bodies, four lag hinges and the drive.
+    assert!(kinds("rigid body") >= 6, "{shapes:?}");
+    assert_eq!(kinds("revolute joint"), 5);
+    let blade = shapes
+        .iter()
+        .find(|s| {
+            s["name"].as_str().is_some_and(|n| n.contains("blade")) && s["kind"] == "rigid body"
+        })
+        .expect("a blade");
+    assert!(blade["info"].as_str().expect("info").contains("kg*m^2"));
+    assert_eq!(blade["look"]["type"], "box");
+    let bytes = std::fs::read(&glb).expect("glb");
+    let g = gltf::Gltf::from_slice(&bytes).expect("a valid glTF binary");
+    check_bounds(&g, g.blob.as_deref().expect("blob"));
+    assert_eq!(g.animations().count(), 0);
+    assert!(g.meshes().count() >= 11);
+    // A usage error without an output.
+    let o = mbd(&["view", "models/windmill.mbd"]);
+    assert_eq!(code(&o), 2);
+}
