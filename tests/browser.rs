@@ -115,7 +115,8 @@ fn the_windmill_view_renders_in_chromium_and_its_blades_turn() {
             .count()
     };
     let drawn = far(&a);
-    assert!(drawn > 5_000, "the scene looks empty: {drawn} drawn pixels");
+    // Measured 17,329 drawn pixels.
+    assert!(drawn > 6_000, "the scene looks empty: {drawn} drawn pixels");
     let moved = scene_rows
         .flat_map(|y| (0..a.width()).map(move |x| (x, y)))
         .filter(|&(x, y)| {
