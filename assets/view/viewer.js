@@ -75,6 +75,10 @@
     } else if (look.type === "grid") {
       const grid = new THREE.GridHelper(look.size, 20, 0x9aa3ad, 0xc9ced6);
       grid.quaternion.setFromUnitVectors(Y, new THREE.Vector3(look.normal[0], look.normal[1], look.normal[2]));
+      // Under the model: at its lowest point along up at the start.
+      let low = 0;
+      for (let i = 0; i < nA; i++) low = Math.min(low, P[3 * i] * up.x + P[3 * i + 1] * up.y + P[3 * i + 2] * up.z);
+      grid.position.copy(up).multiplyScalar(low);
       anchors[s.anchor].add(grid);
       continue;
     } else if (look.type === "link") {
