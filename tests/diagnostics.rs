@@ -51,6 +51,16 @@ const CASES: &[(&str, &[Code])] = &[
     ("wrong_reference", &[Code::E0222]),
     ("loop_too_long", &[Code::E0223]),
     ("declaration_shape", &[Code::E0224]),
+    (
+        "shapes",
+        &[
+            Code::E0213,
+            Code::E0206,
+            Code::E0213,
+            Code::E0224,
+            Code::E0224,
+        ],
+    ),
     ("output_function_unknown", &[Code::E0225]),
     ("output_function_arguments", &[Code::E0225, Code::E0225]),
     ("multiblade_single_joint", &[Code::E0226]),

@@ -180,8 +180,8 @@ fn windmill() -> String {
             "top_mass = ma, mass_per_length = mpl, elements = n_el)",
         )
         .replace(
-            "slider_tower(base = earth, mass = ma, stiffness = M * omega_T^2)",
-            "slider_tower(base = earth, mass = ma + m_eff, stiffness = M * omega_T^2 / shear)",
+            "slider_tower(base = earth, mass = ma, stiffness = M * omega_T^2,",
+            "slider_tower(base = earth, mass = ma + m_eff, stiffness = M * omega_T^2 / shear,",
         )
         .replace(
             "param h = 3.6 m",
@@ -217,7 +217,7 @@ fn a_windmill_on_a_light_cantilever_tower_follows_the_windmill_on_the_slider() {
         simulate_text_with("windmill.mbd", &text, sets, over).unwrap_or_else(|(_, m)| panic!("{m}"))
     };
     assert!(
-        text.contains("n_el") && text.contains("m_eff"),
+        text.contains("elements = n_el") && text.contains("mass = ma + m_eff"),
         "the replacements took"
     );
     let shear = format!("shear={}", 1.0 + 12.0 * G);

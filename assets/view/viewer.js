@@ -56,6 +56,16 @@
     g.setAttribute("color", new THREE.Float32BufferAttribute([1, 0, 0, 1, 0, 0, 0, 0.6, 0, 0, 0.6, 0, 0, 0, 1, 0, 0, 1], 3));
     return new THREE.LineSegments(g, new THREE.LineBasicMaterial({ vertexColors: true }));
   };
+  // A helix of radius r and `turns` turns from y = -1/2 to 1/2, its wire r / 6 thick.
+  const helix = (r, turns) => {
+    class Helix extends THREE.Curve {
+      getPoint(u, target = new THREE.Vector3()) {
+        const a = 2 * Math.PI * turns * u;
+        return target.set(r * Math.cos(a), u - 0.5, r * Math.sin(a));
+      }
+    }
+    return new THREE.TubeGeometry(new Helix(), 24 * turns, r / 6, 6, false);
+  };
   for (const s of data.shapes) {
     const look = s.look;
     let obj = null;
@@ -82,7 +92,9 @@
       anchors[s.anchor].add(grid);
       continue;
     } else if (look.type === "link") {
-      const mesh = new THREE.Mesh(new THREE.CylinderGeometry(look.radius, look.radius, 1, 16, 1, look.coils > 0), material(s.color, look.coils > 0 ? { wireframe: true } : {}));
+      // A spring is a helix of `coils` turns along the unit height, stretched with the link.
+      const geometry = look.coils > 0 ? helix(look.radius, look.coils) : new THREE.CylinderGeometry(look.radius, look.radius, 1, 16, 1);
+      const mesh = new THREE.Mesh(geometry, material(s.color));
       scene.add(mesh);
       links.push({ mesh, from: s.anchor, to: look.to });
       mesh.userData.shape = s;
@@ -91,7 +103,15 @@
     } else if (look.type === "arrow") {
       const arrow = new THREE.ArrowHelper(X, new THREE.Vector3(), size * 0.1, s.color);
       scene.add(arrow);
-      arrows.push({ arrow, anchor: s.anchor, load: look.load, scale: look.scale });
+      // A torque is a double-headed arrow (the right-hand rule's vector).
+      let second = null;
+      if (data.torques[look.load]) {
+        second = new THREE.Mesh(arrow.cone.geometry, arrow.cone.material);
+        arrow.add(second);
+        second.userData.shape = s;
+        pickable.push(second);
+      }
+      arrows.push({ arrow, second, anchor: s.anchor, load: look.load, scale: look.scale });
       arrow.line.userData.shape = s;
       arrow.cone.userData.shape = s;
       pickable.push(arrow.line, arrow.cone);
@@ -152,6 +172,11 @@
         ar.arrow.setDirection(d.divideScalar(m));
         const len = Math.max(ar.scale * m / loadMax[ar.load], 1e-6);
         ar.arrow.setLength(len, 0.25 * len, 0.12 * len);
+        if (ar.second) {
+          // The second head just below the first, as the arrow's cone is placed and scaled.
+          ar.second.scale.copy(ar.arrow.cone.scale);
+          ar.second.position.copy(ar.arrow.cone.position).addScaledVector(Y, -0.2 * len);
+        }
       }
     }
     for (const [anchor, line] of traces) line.geometry.setDrawRange(0, k + 1);

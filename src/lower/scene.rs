@@ -3,7 +3,9 @@
 //! springs, load arrows, the ground. Sizes of symbols are fractions of the model's size.
 
 use super::{nodes, Lower};
-use crate::model::{Attach, Body, BodyKind, JointKind, LoadKind, Marker, Model, SpringKind};
+use crate::model::{
+    Attach, Body, BodyKind, Geometry, GeometryShape, JointKind, LoadKind, Marker, Model, SpringKind,
+};
 use crate::runtime::rotation::{M3, V3};
 use crate::runtime::scene::{Anchor, LoadVector, Look, Scene, Shape};
 use crate::runtime::{m3, End};
@@ -15,6 +17,7 @@ const JOINT: u32 = 0xc0392b;
 const SPRING: u32 = 0x27ae60;
 const LOAD: u32 = 0x8e44ad;
 const GROUND: u32 = 0x7f8c8d;
+const GEOMETRY: u32 = 0x9aa3ad;
 
 /// The model's scene at its initial configuration.
 pub fn scene(model: &Model) -> Scene {
@@ -89,6 +92,9 @@ pub fn scene(model: &Model) -> Scene {
             color: SPRING,
         });
     }
+    for g in &model.geometry {
+        geometry(&lw, &mut s, g);
+    }
     for l in &model.loads {
         let a = marker_anchor(&lw, &mut s, &l.marker, None);
         let (kind, unit) = match l.kind {
@@ -117,6 +123,56 @@ pub fn scene(model: &Model) -> Scene {
         });
     }
     s
+}
+
+/// A shape declared for the view: a cylinder between two markers, a box or a sphere on one.
+fn geometry(lw: &Lower, s: &mut Scene, g: &Geometry) {
+    let a = marker_anchor(lw, s, &g.markers[0], None);
+    let (look, info) = match g.shape {
+        GeometryShape::Cylinder { radius } => {
+            let b = marker_anchor(lw, s, &g.markers[1], None);
+            let info = format!(
+                "radius {} m, from {} to {}",
+                num(radius),
+                g.markers[0].text,
+                g.markers[1].text
+            );
+            (
+                Look::Link {
+                    to: b,
+                    radius,
+                    coils: 0,
+                },
+                info,
+            )
+        }
+        GeometryShape::Box { size } => (
+            Look::Box {
+                half: size.map(|x| 0.5 * x),
+                center: [0.0; 3],
+            },
+            format!("size {} on {}", vector(size, "m"), g.markers[0].text),
+        ),
+        GeometryShape::Sphere { radius } => (
+            Look::Sphere {
+                radius,
+                center: [0.0; 3],
+            },
+            format!("radius {} m on {}", num(radius), g.markers[0].text),
+        ),
+    };
+    let color = g.color.map_or(GEOMETRY, |c| {
+        let b = c.map(|x| (x * 255.0).round() as u32);
+        (b[0] << 16) | (b[1] << 8) | b[2]
+    });
+    s.shapes.push(Shape {
+        name: g.name.clone(),
+        kind: "shape (drawn only)".to_string(),
+        info,
+        anchor: a,
+        look,
+        color,
+    });
 }
 
 /// A beam: a tube through its nodes, each node's section axes.
@@ -179,10 +235,20 @@ fn marker_anchor(lw: &Lower, s: &mut Scene, m: &Marker, axis: Option<[f64; 3]>) 
 
 fn body(lw: &Lower, s: &mut Scene, bi: usize, b: &Body, symbol: f64) {
     let x = V3::from(b.position);
-    let anchor = add_anchor(
-        s,
-        lw.end_at(&Attach::Body { body: bi }, x, &m3(&b.orientation)),
-    );
+    let at = Attach::Body { body: bi };
+    let axes = m3(&b.orientation);
+    let anchor = add_anchor(s, lw.end_at(&at, x, &axes));
+    // The inertia box along the principal axes: its own anchor when they are not the body's.
+    let (moments, principal) = principal(&m3(&b.inertia));
+    let (box_anchor, box_center) = if principal == M3::identity() {
+        (anchor, b.center)
+    } else {
+        let c = principal.transpose() * V3::from(b.center);
+        (
+            add_anchor(s, lw.end_at(&at, x, &(axes * principal))),
+            c.into(),
+        )
+    };
     let (look, kind) = match (b.kind, b.beam_axis) {
         (BodyKind::PointMass, _) => (
             Look::Sphere {
@@ -201,11 +267,16 @@ fn body(lw: &Lower, s: &mut Scene, bi: usize, b: &Body, symbol: f64) {
         ),
         (BodyKind::Rigid, None) => (
             Look::Box {
-                half: inertia_box(b, symbol),
-                center: b.center,
+                half: inertia_box(b.mass, moments, symbol),
+                center: box_center,
             },
             "rigid body",
         ),
+    };
+    let shape_anchor = if matches!(look, Look::Box { .. }) {
+        box_anchor
+    } else {
+        anchor
     };
     let color = if b.kind == BodyKind::PointMass {
         POINT_MASS
@@ -213,10 +284,24 @@ fn body(lw: &Lower, s: &mut Scene, bi: usize, b: &Body, symbol: f64) {
         BODY
     };
     let d = [b.inertia[0][0], b.inertia[1][1], b.inertia[2][2]];
+    let i = &b.inertia;
+    let products = if i[0][1] != 0.0 || i[0][2] != 0.0 || i[1][2] != 0.0 {
+        format!(
+            ", products ({}, {}, {}), principal moments ({}, {}, {})",
+            num(i[0][1]),
+            num(i[0][2]),
+            num(i[1][2]),
+            num(moments[0]),
+            num(moments[1]),
+            num(moments[2])
+        )
+    } else {
+        String::new()
+    };
     let info = match b.kind {
         BodyKind::PointMass => format!("{} kg", num(b.mass)),
         BodyKind::Rigid => format!(
-            "{} kg, inertia about the centre of mass ({}, {}, {}) kg*m^2",
+            "{} kg, inertia about the centre of mass ({}, {}, {}){products} kg*m^2",
             num(b.mass),
             num(d[0]),
             num(d[1]),
@@ -227,7 +312,7 @@ fn body(lw: &Lower, s: &mut Scene, bi: usize, b: &Body, symbol: f64) {
         name: b.name.clone(),
         kind: kind.to_string(),
         info,
-        anchor,
+        anchor: shape_anchor,
         look,
         color,
     });
@@ -243,17 +328,30 @@ fn body(lw: &Lower, s: &mut Scene, bi: usize, b: &Body, symbol: f64) {
     }
 }
 
-/// The half-sizes of the uniform box with the body's mass and principal moments (the
-/// diagonal of its inertia in its own axes); at least `symbol / 4` each, `symbol` for a body
-/// without inertia.
-fn inertia_box(b: &Body, symbol: f64) -> [f64; 3] {
-    let i = [b.inertia[0][0], b.inertia[1][1], b.inertia[2][2]];
-    if b.mass <= 0.0 || i.iter().all(|x| *x <= 0.0) {
+/// The principal moments of an inertia matrix and its principal axes as the columns of a
+/// proper rotation (the identity when the matrix is diagonal, so the box keeps the body's
+/// axes and order).
+fn principal(i: &M3) -> ([f64; 3], M3) {
+    if i[(0, 1)] == 0.0 && i[(0, 2)] == 0.0 && i[(1, 2)] == 0.0 {
+        return ([i[(0, 0)], i[(1, 1)], i[(2, 2)]], M3::identity());
+    }
+    let e = nalgebra::SymmetricEigen::new(*i);
+    let mut p = e.eigenvectors;
+    if p.determinant() < 0.0 {
+        p.set_column(2, &(-p.column(2)));
+    }
+    (e.eigenvalues.into(), p)
+}
+
+/// The half-sizes of the uniform box with the body's mass and principal moments; at least
+/// `symbol / 4` each, `symbol` for a body without inertia.
+fn inertia_box(mass: f64, i: [f64; 3], symbol: f64) -> [f64; 3] {
+    if mass <= 0.0 || i.iter().all(|x| *x <= 0.0) {
         return [symbol; 3];
     }
     // I_x = m (b^2 + c^2) / 12 for full sizes a, b, c: a^2 = 6 (I_y + I_z - I_x) / m.
     let full = |k: usize| {
-        let sq = 6.0 * (i[(k + 1) % 3] + i[(k + 2) % 3] - i[k]) / b.mass;
+        let sq = 6.0 * (i[(k + 1) % 3] + i[(k + 2) % 3] - i[k]) / mass;
         sq.max(0.0).sqrt()
     };
     [0, 1, 2].map(|k| (0.5 * full(k)).max(0.25 * symbol))
@@ -353,6 +451,9 @@ fn model_size(model: &Model) -> f64 {
     }
     for j in &model.joints {
         pts.extend(j.markers.iter().map(|m| m.position));
+    }
+    for g in &model.geometry {
+        pts.extend(g.markers.iter().map(|m| m.position));
     }
     let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
     for p in &pts {

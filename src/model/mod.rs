@@ -78,6 +78,8 @@ pub struct Model {
     pub loads: Vec<Load>,
     /// Forces and torques per length along beams.
     pub distributed: Vec<DistributedLoad>,
+    /// Shapes drawn by the 3-D view only (`cylinder`, `box`, `sphere`): no mass, no unknowns.
+    pub geometry: Vec<Geometry>,
     pub outputs: Vec<OutputChannel>,
     /// Closed-form solutions of output channels (`exact phi = Omega * t`).
     pub exact: Vec<ExactReference>,
@@ -319,6 +321,36 @@ pub struct Spring {
     /// Free length (linear springs).
     pub length: f64,
     pub markers: [Marker; 2],
+}
+
+/// What a `cylinder`, `box` or `sphere` declaration draws (m).
+#[derive(Clone, Debug, Serialize)]
+#[serde(tag = "shape", rename_all = "snake_case")]
+pub enum GeometryShape {
+    /// From the first marker to the second, each end following its marker.
+    Cylinder {
+        radius: f64,
+    },
+    /// Centred at the marker, along its axes, with these full sizes.
+    Box {
+        size: [f64; 3],
+    },
+    Sphere {
+        radius: f64,
+    },
+}
+
+/// A shape the 3-D view draws on markers: the tower under a rotor, a fuselage. It has no
+/// mass and adds no unknowns.
+#[derive(Clone, Debug, Serialize)]
+pub struct Geometry {
+    pub name: String,
+    pub span: Span,
+    pub shape: GeometryShape,
+    /// One marker (box, sphere) or two (cylinder).
+    pub markers: Vec<Marker>,
+    /// sRGB components in 0..1, when given.
+    pub color: Option<[f64; 3]>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]

@@ -12,6 +12,7 @@ mod connect;
 mod curve;
 mod distributed;
 mod exact;
+mod geometry;
 mod initial;
 mod joints;
 mod markers;
@@ -49,6 +50,7 @@ pub(super) enum Built {
     Load(usize),
     Distributed(usize),
     Mass,
+    Geometry,
 }
 
 /// The parts of an entity declaration.
@@ -77,6 +79,7 @@ pub(super) struct Builder<'s> {
     pub springs: Vec<Spring>,
     pub loads: Vec<Load>,
     pub distributed: Vec<DistributedLoad>,
+    pub geometry: Vec<Geometry>,
     /// Set while a distributed load's value is built: the only place `span` may appear.
     pub span_allowed: bool,
     /// `beam NAME rigid` builds the elastic beam ([`Overrides::elastic`]).
@@ -104,6 +107,9 @@ pub(super) const KINDS: &[&str] = &[
     "distributed_force",
     "distributed_torque",
     "concentrated_mass",
+    "cylinder",
+    "box",
+    "sphere",
 ];
 
 /// Builds and checks the model. Every error found is pushed to `sink`, each mistake once (a
@@ -198,6 +204,7 @@ fn build_model(
         springs: b.springs,
         loads: b.loads,
         distributed: b.distributed,
+        geometry: b.geometry,
         outputs,
         exact,
         solve: solve?,
@@ -263,6 +270,7 @@ impl<'s> Builder<'s> {
             springs: Vec::new(),
             loads: Vec::new(),
             distributed: Vec::new(),
+            geometry: Vec::new(),
             span_allowed: false,
             elastic: false,
             body_decl: Vec::new(),
@@ -391,6 +399,7 @@ impl<'s> Builder<'s> {
             "force" | "torque" => self.load(v),
             "distributed_force" | "distributed_torque" => self.distributed_load(v),
             "concentrated_mass" => self.concentrated_mass(v),
+            "cylinder" | "box" | "sphere" => self.geometry(v),
             other => {
                 let hint = match did_you_mean(other, KINDS.iter().copied()) {
                     Some(s) => format!("did you mean `{s}`? Declarations: {}", KINDS.join(", ")),

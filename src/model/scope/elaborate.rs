@@ -547,13 +547,14 @@ impl<'a> Elaborator<'a> {
         file: &str,
     ) {
         let c = match self.env.eval_in(scope, cond) {
-            Ok(crate::model::eval::Value::Scalar { value, dim }) if dim.is_none() => value != 0.0,
+            // Any constant scalar, `if height { ... }` too: true when it is not zero.
+            Ok(crate::model::eval::Value::Scalar { value, .. }) => value != 0.0,
             Ok(v) => {
                 return self.error(
                     scope,
                     Diagnostic::error(Code::E0209, format!("a condition must be a constant number, found {}", v.kind_name()))
                         .at(cond.span, "not a condition")
-                        .hint("write `if elastic { ... }` with a `bool` parameter, or any dimensionless number (true when not 0)"),
+                        .hint("write `if elastic { ... }` with a `bool` parameter, or any constant number or quantity (true when not 0)"),
                 )
             }
             Err(d) => return self.error(scope, d),

@@ -59,6 +59,10 @@ pub fn report(model: &Model) -> String {
             model.loads.len()
         );
     }
+    if !model.geometry.is_empty() {
+        let names: Vec<&str> = model.geometry.iter().map(|g| g.name.as_str()).collect();
+        let _ = writeln!(s, "shapes drawn by the view only: {}", names.join(", "));
+    }
     let _ = writeln!(
         s,
         "unknowns: {} ({} nodes, {coords} DOFs, {} extra unknowns, {} multipliers), bandwidth {}",
