@@ -323,3 +323,66 @@ solve hht { dt = 1 ms, until = 0.01 s }
     // f32 quaternions: measured 6.1e-8 kg*m^2.
     assert!(worst < 2e-7, "{back} {worst}");
 }
+
+/// A spring in the glTF binary is the HTML view's helix: 8 turns of radius r about the unit
+/// link's axis (y, from -1/2 to 1/2), its wire r / 6 thick, every triangle facing outward.
+#[test]
+fn a_spring_in_the_gltf_is_a_helix_facing_outward() {
+    let model = temp(
+        "spring_glb.mbd",
+        "model sprung
+ground earth
+rigid bob { mass = 1 kg, inertia = (0.01, 0.01, 0.01) kg*m^2, at = (0, -1, 0) m }
+spring hang(earth, bob) { stiffness = 100 N/m }
+joint rail = prismatic(earth, bob) { axis = y }
+output y = bob.position.y
+solve hht { dt = 1 ms, until = 0.01 s }
+",
+    );
+    let (glb, html) = (temp("spring.glb", ""), temp("spring.html", ""));
+    let o = mbd(&[
+        "view",
+        model.to_str().expect("path"),
+        "-o",
+        html.to_str().expect("path"),
+        "--gltf",
+        glb.to_str().expect("path"),
+    ]);
+    assert_eq!(code(&o), 0, "{}", stderr(&o));
+    let bytes = std::fs::read(&glb).expect("glb");
+    let g = gltf::Gltf::from_slice(&bytes).expect("a valid glTF binary");
+    let blob = g.blob.as_deref().expect("blob");
+    check_bounds(&g, blob);
+    let mesh = g
+        .meshes()
+        .find(|m| m.name() == Some("hang"))
+        .expect("the spring's mesh");
+    let prim = mesh.primitives().next().expect("primitive");
+    let p = read(
+        blob,
+        &prim.get(&gltf::Semantic::Positions).expect("positions"),
+    );
+    let n = read(blob, &prim.get(&gltf::Semantic::Normals).expect("normals"));
+    // 8 turns of 24 segments, 6 around the wire, two triangles each.
+    assert_eq!(p.len(), 3 * 8 * 24 * 6 * 6);
+    let d = page_data(&std::fs::read_to_string(&html).expect("html"));
+    let shapes = d["shapes"].as_array().expect("shapes");
+    let spring = shapes.iter().find(|s| s["name"] == "hang").expect("hang");
+    assert_eq!(spring["look"]["coils"], 8);
+    let r = spring["look"]["radius"].as_f64().expect("radius");
+    let wire = r / 6.0;
+    for v in p.chunks(3) {
+        let radial = (v[0] as f64).hypot(v[2] as f64);
+        assert!(
+            (radial - r).abs() <= wire * 1.0001 && (v[1] as f64).abs() <= 0.5 + wire,
+            "{v:?}"
+        );
+    }
+    for (t, m) in p.chunks(9).zip(n.chunks(9)) {
+        let at = |k: usize| nalgebra::Vector3::new(t[3 * k], t[3 * k + 1], t[3 * k + 2]);
+        let face = (at(1) - at(0)).cross(&(at(2) - at(0)));
+        let mean =
+            nalgebra::Vector3::new(m[0] + m[3] + m[6], m[1] + m[4] + m[7], m[2] + m[5] + m[8]);
+        assert!(face.dot(&mean) > 0.0, "a triangle faces inward: {t:?}");
+    }
+}

@@ -166,6 +166,7 @@ fn triangles(look: &Look) -> Option<(Vec<f32>, Vec<f32>)> {
                 V3::from(*center),
             );
         }
+        Look::Link { radius, coils, .. } if *coils > 0 => helix(&mut tri, *radius, *coils),
         Look::Link { radius, .. } => cylinder(&mut tri, *radius, -0.5, 0.5, 1, V3::zeros()),
         Look::Arrow { .. } => {
             // A unit arrow along +y: shaft to 0.75, head to 1.
@@ -204,6 +205,37 @@ fn cylinder(tri: &mut Tri, r: f64, a: f64, b: f64, along: usize, c: V3) {
         tri(pa, qa, qb, p, q, q);
         tri(c + axis * b, pb, qb, axis, axis, axis);
         tri(c + axis * a, qa, pa, -axis, -axis, -axis);
+    }
+}
+
+/// A spring's helix of radius `r` and `turns` turns from y = -1/2 to 1/2 (the link's unit
+/// length, scaled along y by its animation), its wire `r / 6` thick: as the HTML view draws it.
+fn helix(tri: &mut Tri, r: f64, turns: u32) {
+    let (along, around) = (24 * turns as usize, 6);
+    let wire = r / 6.0;
+    let w = 2.0 * PI * turns as f64;
+    // The point of the wire's surface at step i along the helix, angle k around it, and its
+    // normal: the wire's centre line, its tangent, and a frame normal to the tangent.
+    let at = |i: usize, k: usize| {
+        let u = i as f64 / along as f64;
+        let a = w * u;
+        let c = V3::new(r * a.cos(), u - 0.5, r * a.sin());
+        let t = V3::new(-r * w * a.sin(), 1.0, r * w * a.cos()).normalize();
+        let inward = V3::new(-a.cos(), 0.0, -a.sin());
+        let b = t.cross(&inward);
+        let ph = 2.0 * PI * k as f64 / around as f64;
+        let d = inward * ph.cos() + b * ph.sin();
+        (c + d * wire, d)
+    };
+    for i in 0..along {
+        for k in 0..around {
+            let (p, np) = at(i, k);
+            let (q, nq) = at(i + 1, k);
+            let (s, ns) = at(i + 1, k + 1);
+            let (o, no) = at(i, k + 1);
+            tri(p, s, q, np, ns, nq);
+            tri(p, o, s, np, no, ns);
+        }
     }
 }
 
