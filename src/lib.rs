@@ -294,13 +294,16 @@ pub fn scene(c: &Compiled) -> runtime::scene::Scene {
     lower::scene(&c.model)
 }
 
+/// What [`run_observed`] calls at every written row: the state and the row's values.
+pub type Observer<'a> = &'a mut dyn FnMut(&runtime::State, &[f64]);
+
 /// [`run_with_progress`], calling `observe(state, values)` at every written row (the start
 /// included) with the row's channel values: what a 3-D view samples.
 pub fn run_observed(
     c: &Compiled,
     out: &mut dyn Write,
     progress: &mut dyn FnMut(usize, usize),
-    mut observe: Option<&mut dyn FnMut(&runtime::State, &[f64])>,
+    mut observe: Option<Observer<'_>>,
 ) -> Result<RunReport, RunFailure> {
     let set = &c.settings;
     let l = &c.lowered;

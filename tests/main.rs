@@ -1,5 +1,6 @@
 //! One integration-test binary (keeps link time down); each module is one concern.
 
+mod alloc;
 mod architecture;
 mod beam_order;
 mod beams;

@@ -101,7 +101,7 @@ impl Recorder {
 
     /// A written row: sampled every `stride` rows; the last one is kept aside.
     pub fn sample(&mut self, st: &State, values: &[f64]) {
-        let keep = self.seen % self.stride == 0;
+        let keep = self.seen.is_multiple_of(self.stride);
         self.seen += 1;
         if keep {
             self.scene.sample(st, &mut self.frames);

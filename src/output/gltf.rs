@@ -27,7 +27,7 @@ struct Doc {
 impl Doc {
     /// Appends floats as an accessor of `kind` (`VEC3`, `SCALAR`, ...) with their bounds.
     fn floats(&mut self, v: &[f32], kind: &str, width: usize, target: Option<u32>) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -411,7 +411,7 @@ pub fn write_glb(
 
 /// The GLB container: header, JSON chunk (padded with spaces), binary chunk.
 fn glb(out: &mut dyn Write, mut text: Vec<u8>, bin: &[u8]) -> io::Result<()> {
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let total = 12 + 8 + text.len() + 8 + bin.len();

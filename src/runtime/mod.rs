@@ -215,34 +215,23 @@ impl System {
         self.unknowns.is_empty()
     }
 
-    /// Mean translational mass, for constraint scaling (THEORY §6).
+    /// Mean translational mass, for constraint scaling (THEORY §6). Allocates nothing: it is
+    /// asked once a step.
     pub fn mean_mass(&self) -> f64 {
-        let masses: Vec<f64> = self
-            .elements
-            .iter()
-            .filter_map(|e| e.translational_mass())
-            .filter(|m| *m > 0.0)
-            .collect();
-        if masses.is_empty() {
-            1.0
-        } else {
-            masses.iter().sum::<f64>() / masses.len() as f64
-        }
+        let masses = self.elements.iter().filter_map(|e| e.translational_mass());
+        mean(masses.filter(|m| *m > 0.0)).unwrap_or(1.0)
     }
 
     /// Mean elastic stiffness diagonal, for constraint scaling (THEORY §6).
     pub fn mean_stiffness(&self) -> f64 {
-        let k: Vec<f64> = self
-            .elements
-            .iter()
-            .filter_map(|e| e.stiffness_scale())
-            .collect();
-        if k.is_empty() {
-            0.0
-        } else {
-            k.iter().sum::<f64>() / k.len() as f64
-        }
+        mean(self.elements.iter().filter_map(|e| e.stiffness_scale())).unwrap_or(0.0)
     }
+}
+
+/// The mean of the values, `None` for none.
+fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    (n > 0).then(|| sum / n as f64)
 }
 
 /// Kinematics of one rotating node: rotation from its initial orientation, angular velocity

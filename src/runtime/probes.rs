@@ -71,18 +71,24 @@ impl Coleman {
 
     /// The coordinate of blade values `zeta` at rotor azimuth `psi`.
     pub fn of(self, zeta: &[f64], psi: f64) -> f64 {
-        let n = zeta.len() as f64;
-        let azimuth = |k: usize| psi + std::f64::consts::TAU * k as f64 / n;
-        let sum = |w: &dyn Fn(usize) -> f64| -> f64 {
-            zeta.iter().enumerate().map(|(k, z)| z * w(k)).sum()
-        };
+        self.of_blades(zeta.len(), |k| zeta[k], psi)
+    }
+
+    /// The coordinate of `n` blade values `zeta(k)` at rotor azimuth `psi`, without
+    /// gathering them (a probe at every written row).
+    pub fn of_blades(self, n: usize, zeta: impl Fn(usize) -> f64, psi: f64) -> f64 {
+        let count = n as f64;
+        let azimuth = |k: usize| psi + std::f64::consts::TAU * k as f64 / count;
+        let sum = |w: &dyn Fn(usize) -> f64| -> f64 { (0..n).map(|k| zeta(k) * w(k)).sum() };
         match self {
-            Coleman::Collective => sum(&|_| 1.0) / n,
+            Coleman::Collective => sum(&|_| 1.0) / count,
             Coleman::Cosine { harmonic } => {
-                2.0 / n * sum(&|k| (harmonic as f64 * azimuth(k)).cos())
+                2.0 / count * sum(&|k| (harmonic as f64 * azimuth(k)).cos())
             }
-            Coleman::Sine { harmonic } => 2.0 / n * sum(&|k| (harmonic as f64 * azimuth(k)).sin()),
-            Coleman::Differential => sum(&|k| if k % 2 == 0 { 1.0 } else { -1.0 }) / n,
+            Coleman::Sine { harmonic } => {
+                2.0 / count * sum(&|k| (harmonic as f64 * azimuth(k)).sin())
+            }
+            Coleman::Differential => sum(&|k| if k % 2 == 0 { 1.0 } else { -1.0 }) / count,
         }
     }
 }
@@ -232,11 +238,9 @@ impl System {
                 azimuth,
                 coordinate,
             } => {
-                let zeta: Vec<f64> = blades
-                    .iter()
-                    .map(|&b| self.joint_angle(b, st, false))
-                    .collect();
-                coordinate.of(&zeta, self.joint_angle(*azimuth, st, false))
+                let zeta = |k: usize| self.joint_angle(blades[k], st, false);
+                let psi = self.joint_angle(*azimuth, st, false);
+                coordinate.of_blades(blades.len(), zeta, psi)
             }
             Probe::CenterOfMass {
                 elements,
