@@ -10,8 +10,13 @@ use std::process::Command;
 
 const CHROMIUM: &str = "/usr/bin/chromium";
 
-/// Chromium, installed from Debian's packages if it is missing.
+/// Chromium, installed from Debian's packages if it is missing. One test installs it while the
+/// others wait: two `apt-get`s at once fail on dpkg's lock (seen on a clean machine).
 fn chromium() -> PathBuf {
+    static INSTALL: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _one_at_a_time = INSTALL
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner());
     let path = PathBuf::from(CHROMIUM);
     if !path.exists() {
         let apt = |args: &[&str]| {
