@@ -227,10 +227,10 @@ impl Assembler {
     }
 
     /// The residual parts of the elements that read the rates (`all`), or of those whose
-    /// derivatives are not in [`Assembler::rate_jacobians`] (joints with rate rows): its
-    /// difference between two states of the same positions is the whole residual's, or the
-    /// rest of it. Only the rows of [`Assembler::rate_support`] are written (the others hold
-    /// whatever they held).
+    /// derivatives are not in [`Assembler::rate_jacobians`] (joints with rate rows, their rate
+    /// rows alone: [`Element::rate_residual`]): its difference between two states of the
+    /// same positions is the whole residual's, or the rest of it. Only the rows of
+    /// [`Assembler::rate_support`] are written (the others hold whatever they held).
     pub fn rate_residual(&mut self, sys: &System, st: &State, aug: Augment, all: bool) {
         let r = &mut self.residual;
         let support = if all {
@@ -243,19 +243,8 @@ impl Assembler {
         }
         let first: &[usize] = if all { &self.reading.0 } else { &[] };
         for &e in first.iter().chain(&self.reading.1) {
-            sys.elements[e].residual(st, aug, &mut self.residual);
+            sys.elements[e].rate_residual(st, aug, &mut self.residual);
         }
-    }
-
-    /// Whether some element that reads the rates holds elastic forces far above its inertial
-    /// ones (a beam): differences of its residual along the rates cancel those forces only to
-    /// their round-off (a rotating beam's carried direction: 8e-7 from differences, 2e-11
-    /// from [`Assembler::rate_jacobians`]).
-    pub fn rates_need_derivatives(&self, sys: &System) -> bool {
-        self.reading
-            .0
-            .iter()
-            .any(|&e| matches!(sys.elements[e], Element::Beam(_)))
     }
 
     /// The unknowns of the elements [`Assembler::rate_residual`] evaluates: the rows it

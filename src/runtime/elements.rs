@@ -72,6 +72,16 @@ impl Element {
         }
     }
 
+    /// The part of [`Element::residual`] that reads the rates, with the rest as it would be
+    /// or not written: a joint's rate rows alone (its forces `s lambda` and its other rows
+    /// are the positions'), every other element's whole residual.
+    pub fn rate_residual(&self, st: &State, aug: Augment, r: &mut Residual) {
+        match self {
+            Element::Joint(j) => j.rate_rows(st, aug, r),
+            e => e.residual(st, aug, r),
+        }
+    }
+
     /// Writes the local tangent (row-major, `indices().len()` squared) into `k`.
     pub fn tangent(&self, st: &State, aug: Augment, c: TangentCoeffs, k: &mut [f64]) {
         match self {

@@ -3,6 +3,7 @@
 //! Invariant: the symbolic factorization and the workspace are computed once per pattern;
 //! each Newton iteration refactors numerically into the same storage.
 
+use super::ordering::Rule;
 use super::pivot_free::{PivotFree, TinyPivot};
 use crate::runtime::Pattern;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
@@ -40,12 +41,16 @@ struct Pivoting {
 /// A sparse LU whose symbolic work is done once per pattern.
 ///
 /// The iteration matrix's (`SparseLu::pivot_free`) factors without pivoting in the order of
-/// `ordering.rs`; should a pivot be tiny (a model the ordering does not cover), the matrix is
-/// factored with faer's partial pivoting from then on, and only if that fails too is it
+/// `ordering.rs`, each joint's multipliers after one side; should a pivot be tiny, in the
+/// strict order (after both sides) from then on; should a pivot still be tiny (a model the
+/// ordering does not cover), the matrix is factored with faer's partial pivoting from then on, and only if that fails too is it
 /// singular, at the unknown of the tiny pivot. Other matrices (the constrained mass matrix,
 /// which may hold massless rotations) use faer's from the start.
 pub struct SparseLu {
     pattern: Pattern,
+    /// The multipliers, and the rule the pivot-free order follows.
+    late: Vec<bool>,
+    rule: Rule,
     fast: Option<PivotFree>,
     pivoting: Option<Pivoting>,
     tiny: Option<usize>,
@@ -134,6 +139,8 @@ impl SparseLu {
     pub fn new(pattern: &Pattern) -> Result<SparseLu, LinearError> {
         Ok(SparseLu {
             pattern: pattern.clone(),
+            late: Vec::new(),
+            rule: Rule::Strict,
             fast: None,
             pivoting: Some(Pivoting::new(pattern)?),
             tiny: None,
@@ -145,7 +152,9 @@ impl SparseLu {
     pub fn pivot_free(pattern: &Pattern, late: &[bool]) -> SparseLu {
         SparseLu {
             pattern: pattern.clone(),
-            fast: Some(PivotFree::new(pattern, late)),
+            late: late.to_vec(),
+            rule: Rule::OneSide,
+            fast: Some(PivotFree::new(pattern, late, Rule::OneSide)),
             pivoting: None,
             tiny: None,
             factored: false,
@@ -157,6 +166,11 @@ impl SparseLu {
         self.fast.as_ref().map(PivotFree::describe)
     }
 
+    /// The order the pivot-free factorization follows (the strict one after a tiny pivot).
+    pub fn rule(&self) -> Rule {
+        self.rule
+    }
+
     /// The unknown of the first tiny pivot met, after which faer's pivoting LU is used.
     pub fn tiny_pivot(&self) -> Option<usize> {
         self.tiny
@@ -165,15 +179,20 @@ impl SparseLu {
     /// Numeric factorization of the matrix with this pattern and `values`.
     pub fn factor(&mut self, values: &[f64]) -> Result<(), LinearError> {
         self.factored = false;
-        if self.tiny.is_none() {
-            if let Some(fast) = &mut self.fast {
-                match fast.factor(values) {
-                    Ok(()) => {
-                        self.factored = true;
-                        return Ok(());
-                    }
-                    Err(TinyPivot(i)) => self.tiny = Some(i),
+        while self.tiny.is_none() {
+            let Some(fast) = &mut self.fast else { break };
+            match fast.factor(values) {
+                Ok(()) => {
+                    self.factored = true;
+                    return Ok(());
                 }
+                // A joint whose rows are not independent on the side its multipliers
+                // followed: the strict order, made once, from then on.
+                Err(TinyPivot(_)) if self.rule == Rule::OneSide => {
+                    self.rule = Rule::Strict;
+                    *fast = PivotFree::new(&self.pattern, &self.late, Rule::Strict);
+                }
+                Err(TinyPivot(i)) => self.tiny = Some(i),
             }
         }
         if self.pivoting.is_none() {

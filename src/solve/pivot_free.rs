@@ -13,7 +13,7 @@
 
 mod substitute;
 
-use super::ordering::Elimination;
+use super::ordering::{Elimination, Rule};
 use crate::runtime::Pattern;
 
 /// A pivot this small relative to its column's largest entry (or not finite) stops the
@@ -69,8 +69,8 @@ pub struct PivotFree {
 pub struct TinyPivot(pub usize);
 
 impl PivotFree {
-    pub fn new(pattern: &Pattern, late: &[bool]) -> PivotFree {
-        let e = Elimination::of(pattern, late);
+    pub fn new(pattern: &Pattern, late: &[bool], rule: Rule) -> PivotFree {
+        let e = Elimination::of(pattern, late, rule);
         let n = pattern.n;
         let ns = e.supernodes();
         let mut sn = vec![0usize; n];
@@ -360,182 +360,4 @@ impl PivotFree {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::solve::linear::SparseLu;
-
-    /// A matrix of the iteration matrix's shape: `nodes` nodes of `w` unknowns on a chain
-    /// and a star, joints of `k` multipliers between neighbours, `[A + p B^T B, s B^T; s B, 0]`
-    /// with `A` diagonally dominant and unsymmetric.
-    fn augmented(nodes: usize, w: usize, k: usize, seed: u64) -> (Pattern, Vec<bool>, Vec<f64>) {
-        let mut state = seed;
-        let mut rnd = move || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((state >> 11) as f64 / (1u64 << 53) as f64) - 0.5
-        };
-        let mut pairs: Vec<(usize, usize)> = (1..nodes).map(|i| (i - 1, i)).collect();
-        pairs.extend((2..nodes).step_by(3).map(|i| (0, i)));
-        // Multipliers first in the numbering, so the order must move them.
-        let nm = pairs.len() * k;
-        let n = nm + nodes * w;
-        let q = |node: usize, a: usize| nm + node * w + a;
-        let mut dense = vec![0.0; n * n];
-        let mut coupled = vec![false; n * n];
-        let mut couple = |i: usize, j: usize, v: f64, d: &mut Vec<f64>| {
-            d[i + j * n] += v;
-            coupled[i + j * n] = true;
-            coupled[j + i * n] = true;
-        };
-        for node in 0..nodes {
-            for a in 0..w {
-                for b in 0..w {
-                    let v = if a == b { 10.0 } else { rnd() };
-                    couple(q(node, a), q(node, b), v, &mut dense);
-                }
-            }
-        }
-        let (s, p) = (3.0, 3.0);
-        for (c, &(na, nb)) in pairs.iter().enumerate() {
-            let idx: Vec<usize> = (0..w)
-                .map(|a| q(na, a))
-                .chain((0..w).map(|a| q(nb, a)))
-                .collect();
-            for r in 0..k {
-                let b: Vec<f64> = idx.iter().map(|_| rnd()).collect();
-                let m = c * k + r;
-                for (x, &i) in idx.iter().enumerate() {
-                    couple(m, i, s * b[x], &mut dense);
-                    couple(i, m, s * b[x], &mut dense);
-                    for (y, &j) in idx.iter().enumerate() {
-                        couple(i, j, p * b[x] * b[y], &mut dense);
-                    }
-                }
-                for r2 in 0..k {
-                    couple(m, c * k + r2, 0.0, &mut dense);
-                }
-            }
-        }
-        let (mut col_ptr, mut row_idx, mut values) = (vec![0], Vec::new(), Vec::new());
-        for j in 0..n {
-            for i in 0..n {
-                if coupled[i + j * n] || i == j {
-                    row_idx.push(i);
-                    values.push(dense[i + j * n]);
-                }
-            }
-            col_ptr.push(row_idx.len());
-        }
-        let late = (0..n).map(|i| i < nm).collect();
-        (
-            Pattern {
-                n,
-                col_ptr,
-                row_idx,
-            },
-            late,
-            values,
-        )
-    }
-
-    fn solve_both(nodes: usize, w: usize, k: usize, seed: u64) -> (f64, PivotFree) {
-        let (pattern, late, values) = augmented(nodes, w, k, seed);
-        let mut fast = PivotFree::new(&pattern, &late);
-        let mut slow = SparseLu::new(&pattern).expect("faer");
-        let rhs: Vec<f64> = (0..pattern.n).map(|i| (i as f64 * 0.37).sin()).collect();
-        let (mut x, mut y) = (rhs.clone(), rhs);
-        // Twice, so that refactoring into the same storage is checked too.
-        for scale in [1.0, 2.0] {
-            let v: Vec<f64> = values.iter().map(|v| v * scale).collect();
-            fast.factor(&v).expect("no tiny pivot");
-            slow.factor(&v).expect("faer factors");
-        }
-        fast.solve(&mut x);
-        slow.solve(&mut y).expect("faer solves");
-        let size = y.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-        let err = x
-            .iter()
-            .zip(&y)
-            .fold(0.0f64, |m, (a, b)| m.max((a - b).abs()));
-        (err / size, fast)
-    }
-
-    #[test]
-    fn agrees_with_pivoting_lu_on_augmented_lagrangian_matrices() {
-        // Rigid frames with 5-multiplier joints, point masses with 1-multiplier joints.
-        for (nodes, w, k) in [(2, 6, 5), (7, 6, 5), (30, 6, 3), (12, 3, 1), (50, 3, 2)] {
-            for seed in 1..4 {
-                let (err, _) = solve_both(nodes, w, k, seed);
-                assert!(
-                    err < 1e-12,
-                    "{nodes} nodes of {w}, {k} multipliers: {err:e}"
-                );
-            }
-        }
-    }
-
-    /// Several right-hand sides at once give each one's substitution, to round-off.
-    #[test]
-    fn many_right_hand_sides_are_each_ones_substitution() {
-        for (nodes, w, k) in [(7, 6, 5), (30, 6, 3), (12, 3, 1)] {
-            let (_, mut fast) = solve_both(nodes, w, k, 2);
-            let n = fast.perm.len();
-            let count = 5;
-            let rhs: Vec<f64> = (0..n * count).map(|i| (i as f64 * 0.71).cos()).collect();
-            let mut many = rhs.clone();
-            fast.substitute_many(&mut many, count);
-            for c in 0..count {
-                let mut one = rhs[c * n..(c + 1) * n].to_vec();
-                fast.substitute(&mut one);
-                let size = one.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-                for (a, b) in one.iter().zip(&many[c * n..(c + 1) * n]) {
-                    assert!((a - b).abs() <= 1e-13 * size, "{nodes} nodes: {a} vs {b}");
-                }
-            }
-        }
-    }
-
-    #[test]
-    fn multipliers_follow_what_they_couple_and_supernodes_are_blocks() {
-        let (pattern, late, _) = augmented(10, 6, 5, 7);
-        let e = Elimination::of(&pattern, &late);
-        let mut at = vec![0; pattern.n];
-        for (k, &o) in e.perm.iter().enumerate() {
-            at[o] = k;
-        }
-        for j in 0..pattern.n {
-            if late[j] {
-                for &i in &pattern.row_idx[pattern.col_ptr[j]..pattern.col_ptr[j + 1]] {
-                    assert!(
-                        late[i] || at[i] < at[j],
-                        "multiplier {j} before unknown {i}"
-                    );
-                }
-            }
-        }
-        // 10 nodes of 6 and 12 joints of 5 multipliers: one supernode each.
-        assert_eq!(e.supernodes(), 10 + 12);
-    }
-
-    #[test]
-    fn reports_a_tiny_pivot_at_its_unknown() {
-        // [[0, 1], [1, 0]] with neither flagged late: the first pivot is zero.
-        let pattern = Pattern {
-            n: 2,
-            col_ptr: vec![0, 2, 4],
-            row_idx: vec![0, 1, 0, 1],
-        };
-        let mut lu = PivotFree::new(&pattern, &[false, false]);
-        assert!(lu.factor(&[0.0, 1.0, 1.0, 0.0]).is_err());
-        // Flagging the second as a multiplier does not help a zero first pivot, but a
-        // nonzero one factors.
-        lu.factor(&[2.0, 1.0, 1.0, 0.0]).expect("pivots 2 and -0.5");
-        let mut x = [3.0, 1.0];
-        lu.solve(&mut x);
-        assert!(
-            (x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15,
-            "{x:?}"
-        );
-    }
-}
+mod tests;

@@ -367,6 +367,17 @@ impl Joint {
         }
     }
 
+    /// The rate rows' equations alone into `r.constraint`: the only part of the residual
+    /// that reads the rates (their forces `s lambda` do not).
+    pub fn rate_rows(&self, st: &State, aug: Augment, r: &mut Residual) {
+        let geo = Geo::new(&self.a, &self.b, self.angle, st);
+        for (k, row) in self.rows.iter().enumerate() {
+            if row.is_rate() {
+                self.row_residual(k, row, &geo, st, aug, r);
+            }
+        }
+    }
+
     /// Row `k`'s equation into `r.constraint`, and its force `mu` with its gradient.
     #[inline(always)]
     fn row_residual(

@@ -318,7 +318,7 @@ impl Integrator<'_> {
 
     /// The transform's block matrices at the iterate: `H(c)` (conformal) or `R` for the
     /// translation and rotation blocks of each node (SE(3)).
-    fn block_matrices(&mut self) {
+    pub(super) fn block_matrices(&mut self) {
         let nodes = self.sys.rotations.len();
         if self.layout == Layout::Conformal {
             rotations::tangents(self.sys, &self.trial, &mut self.mats);

@@ -26,18 +26,11 @@ use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, log, M
 use crate::runtime::{State, System, UnknownKind};
 use crate::settings::{Method, NewtonMode};
 
-/// The size of a direction's differences of the rates, relative to their scale (lengths in
-/// the model's length scale over the tracked time scale): the residual is quadratic in the
-/// velocities and linear in the accelerations, so the differences are exact but for
-/// round-off, which a large step keeps small.
+/// The size of a direction's differences of the joints' rate rows, relative to their scale
+/// (lengths in the model's length scale over the tracked time scale): the rows are linear in
+/// the velocities, so the differences are exact but for round-off, which a large step keeps
+/// small.
 const EPSILON: f64 = 1e-3;
-
-/// Above this many directions, the residual's derivative along each direction's rates comes
-/// from the elements' rate derivatives assembled once a step (two tangents per element);
-/// below, from central differences of the elements' residuals (two per element and
-/// direction), cheaper for the rigid windmill's 10 (measured: 10 % less per point) and far
-/// dearer for an elastic rotor's hundreds.
-pub(super) const ANALYTIC_ABOVE: usize = 16;
 
 /// The directions carried along a run, and the step's workspace (made once).
 pub(super) struct Tracked {
@@ -69,10 +62,8 @@ pub(super) struct Tracked {
     pub(super) physical: (Vec<f64>, Vec<f64>),
     /// Column-major `n x columns`: each direction's correction of the increment.
     pub(super) gradients: Vec<f64>,
-    /// Whether the elements with inertia take their assembled rate derivatives
-    /// ([`ANALYTIC_ABOVE`]); the unknowns of the elements differenced along the rates (the
-    /// rates they read, the rows they write), and the rotating nodes among them.
-    analytic: bool,
+    /// The unknowns of the joints whose rate rows are differenced along the rates (the rates
+    /// they read, the rows they write), and the rotating nodes among them.
     differenced: (Vec<usize>, Vec<usize>),
 }
 
@@ -181,26 +172,27 @@ fn nodes_of(sys: &System, unknowns: &[usize]) -> Vec<usize> {
 }
 
 /// The velocities and accelerations as `base` holds them (rotations: angular velocity and
-/// acceleration; frames' translations: in inertial axes) moved by a direction of the rates
-/// alone: [`perturb_rates`]'s change to first order, which is exact but for the frames'
-/// `w x v` (`se3::to_physical`).
+/// acceleration; frames' translations: in inertial axes) moved by each of `count` directions
+/// of the rates alone (`dirs` column-major, `4 n` a direction; `dv`, `da` column-major
+/// `n x count`): [`perturb_rates`]'s change to first order, which is exact but for the
+/// frames' `w x v` (`se3::to_physical`).
 pub(super) fn physical_rates(
     sys: &System,
     in_frame: &[bool],
     base: &State,
-    dir: &[f64],
+    (dirs, count): (&[f64], usize),
     (dv, da): (&mut [f64], &mut [f64]),
 ) {
     let n = sys.len();
     dv.fill(0.0);
     da.fill(0.0);
-    for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
-        dv[i] = dir[n + i];
-        da[i] = dir[2 * n + i];
+    for c in 0..count {
+        let dir = &dirs[c * 4 * n..(c + 1) * 4 * n];
+        for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
+            dv[c * n + i] = dir[n + i];
+            da[c * n + i] = dir[2 * n + i];
+        }
     }
-    let part = |k: usize, at: usize, from: usize| {
-        V3::from_fn(|j, _| slot(sys, k, from + j).map_or(0.0, |s| dir[at * n + s]))
-    };
     for k in 0..sys.rotations.len() {
         let (t, r) = (sys.translations[k], sys.rotations[k]);
         let rm = base.rot[k].matrix();
@@ -209,19 +201,28 @@ pub(super) fn physical_rates(
             V3::new(f.v[0], f.v[1], f.v[2]),
             V3::new(f.v[3], f.v[4], f.v[5]),
         );
-        let (dw, ddw) = (part(k, 1, 3), part(k, 2, 3));
-        if sys.is_frame(k) {
-            let (du, ddu) = (part(k, 1, 0), part(k, 2, 0));
-            let (xd, xdd) = (rm * du, rm * (ddu + dw.cross(&v) + w.cross(&du)));
-            for j in 0..3 {
-                dv[t + j] = xd[j];
-                da[t + j] = xdd[j];
+        let frame = sys.is_frame(k);
+        let slots: [Option<usize>; 6] = std::array::from_fn(|j| slot(sys, k, j));
+        for c in 0..count {
+            let dir = &dirs[c * 4 * n..(c + 1) * 4 * n];
+            let part = |at: usize, from: usize| {
+                V3::from_fn(|j, _| slots[from + j].map_or(0.0, |s| dir[at * n + s]))
+            };
+            let (dw, ddw) = (part(1, 3), part(2, 3));
+            let (dv, da) = (&mut dv[c * n..(c + 1) * n], &mut da[c * n..(c + 1) * n]);
+            if frame {
+                let (du, ddu) = (part(1, 0), part(2, 0));
+                let (xd, xdd) = (rm * du, rm * (ddu + dw.cross(&v) + w.cross(&du)));
+                for j in 0..3 {
+                    dv[t + j] = xd[j];
+                    da[t + j] = xdd[j];
+                }
             }
-        }
-        let (om, omd) = (rm * dw, rm * ddw);
-        for j in 0..3 {
-            dv[r + j] = om[j];
-            da[r + j] = omd[j];
+            let (om, omd) = (rm * dw, rm * ddw);
+            for j in 0..3 {
+                dv[r + j] = om[j];
+                da[r + j] = omd[j];
+            }
         }
     }
 }
@@ -305,8 +306,7 @@ impl Integrator<'_> {
         // next step's Newton keeps while it contracts (its first matrix costs nothing then),
         // whatever the settings' mode: the step converges to the same tolerance either way.
         self.reuse = Reuse::new(NewtonMode::Modified, self.method);
-        let analytic = count > ANALYTIC_ABOVE || self.asm.rates_need_derivatives(self.sys);
-        let on = self.asm.rate_support(!analytic).to_vec();
+        let on = self.asm.rate_support(false).to_vec();
         let differenced = (nodes_of(self.sys, &on), on);
         let map = (0..count * count)
             .map(|k| if k % (count + 1) == 0 { 1.0 } else { 0.0 })
@@ -328,7 +328,6 @@ impl Integrator<'_> {
             part: vec![0.0; n],
             physical: (vec![0.0; n * count], vec![0.0; n * count]),
             gradients: vec![0.0; n * count],
-            analytic,
             differenced: (differenced.1, differenced.0),
         }));
     }
@@ -477,9 +476,10 @@ impl Integrator<'_> {
     fn propagate_with(&mut self, h: f64, tk: &mut Tracked) -> Result<(), StepFailure> {
         let (n, aug) = (self.sys.len(), self.aug);
         let dim = 4 * n;
-        // The residual and the iteration matrix at the converged increment.
+        // The iteration matrix at the converged increment (its residual, Newton's last, is
+        // not needed: the matrix reads the state and the nodes' rotations alone).
         self.trial.assign(&self.cur);
-        self.newmark_residual(aug, 0.0)?;
+        self.block_matrices();
         self.exact_rates = true;
         let factored = self.refactor(h, aug, false);
         self.exact_rates = false;
@@ -495,14 +495,8 @@ impl Integrator<'_> {
         tk.gradients.iter_mut().for_each(|x| *x = 0.0);
         // The perturbed states below differ from the end's in their rates alone.
         self.trial.assign(&self.cur);
-        // Many directions, or beams: the elements with inertia through their derivatives,
-        // assembled once; few on rigid bodies: every element that reads the rates by
-        // differences.
-        let analytic = tk.analytic;
-        if analytic {
-            self.asm.rate_jacobians(self.sys, &self.cur, aug);
-        }
-        let differenced = self.asm.has_rate_residual(!analytic);
+        // The elements with inertia through their derivatives, assembled once a step.
+        self.asm.rate_jacobians(self.sys, &self.cur, aug);
         for c in 0..tk.count {
             tk.dir.copy_from_slice(&tk.columns[c * dim..(c + 1) * dim]);
             let moved = &mut tk.columns[c * dim..(c + 1) * dim];
@@ -510,38 +504,38 @@ impl Integrator<'_> {
             // The end's perturbation `m` as a correction of the increment by its positions
             // `x_m` (`D x_m`, whose residual is `J x_m`) and a perturbation of the rates alone,
             // `w = m - D x_m`. Then `x = -x_m - J^-1 r_w` and `S' = w + D (x + x_m)`
-            // `= w - D J^-1 r_w`: the positions' part is exact through `J`, and `r_w`, the
-            // residual's derivative along rates at fixed positions, is quadratic in the
-            // velocities and linear in the accelerations: its central differences are exact
-            // to round-off.
+            // `= w - D J^-1 r_w`: the positions' part is exact through `J`, and `r_w` is the
+            // residual's derivative along the rates at fixed positions.
             tk.part.copy_from_slice(&moved[..n]);
             tk.part.iter_mut().for_each(|x| *x = -*x);
             self.correct(&coef, &tk.nodes, &tk.part, moved);
-            if analytic {
-                let (dv, da) = (&mut tk.physical.0, &mut tk.physical.1);
-                let (dv, da) = (&mut dv[c * n..(c + 1) * n], &mut da[c * n..(c + 1) * n]);
-                physical_rates(self.sys, &self.in_frame, &self.cur, moved, (dv, da));
-            }
         }
+        let (dv, da) = (&mut tk.physical.0, &mut tk.physical.1);
+        let dirs = (&tk.columns[..tk.count * dim], tk.count);
+        physical_rates(self.sys, &self.in_frame, &self.cur, dirs, (dv, da));
         // The elements with inertia or damping through their derivatives, `-(M da + C dv)`.
-        if analytic {
-            let (dv, da) = (&tk.physical.0, &tk.physical.1);
-            self.asm.rate_products(dv, da, tk.count, &mut tk.gradients);
-            tk.gradients.iter_mut().for_each(|g| *g = -*g);
+        let (dv, da) = (&tk.physical.0, &tk.physical.1);
+        self.asm.rate_products(dv, da, tk.count, &mut tk.gradients);
+        tk.gradients.iter_mut().for_each(|g| *g = -*g);
+        // The joints' rate rows, linear in the velocities: differences from the end's values
+        // are exact but for round-off.
+        let on = tk.differenced.0.as_slice();
+        let differenced = self.asm.has_rate_residual(false);
+        if differenced {
+            self.asm.rate_residual(self.sys, &self.cur, aug, false);
+            for &i in on {
+                tk.part[i] = self.asm.residual.constraint[i];
+            }
         }
         for c in 0..tk.count {
             let moved = &tk.columns[c * dim..(c + 1) * dim];
             let gradient = &mut tk.gradients[c * n..(c + 1) * n];
-            // The rest (joints with rate rows, or all) by central differences along the rates,
-            // on the unknowns of the elements differenced (the rates they read, the rows they
-            // write).
-            let on = tk.differenced.0.as_slice();
             let size = if differenced {
                 rate_size(&tk.scale, tk.tau, moved, on)
             } else {
                 0.0
             };
-            for sign in [1.0, -1.0].into_iter().filter(|_| size > 0.0) {
+            if size > 0.0 {
                 let eps = EPSILON / size;
                 let support = (on, tk.differenced.1.as_slice());
                 perturb_rates(
@@ -549,21 +543,14 @@ impl Integrator<'_> {
                     &self.in_frame,
                     &self.cur,
                     moved,
-                    sign * eps,
+                    eps,
                     support,
                     &mut self.trial,
                 );
-                // Only the elements that read the rates: the others' parts cancel.
-                self.asm
-                    .rate_residual(self.sys, &self.trial, aug, !analytic);
-                let r = &self.asm.residual;
-                for &i in on {
-                    gradient[i] -= sign / (2.0 * eps)
-                        * if self.sys.unknowns[i].is_multiplier() {
-                            aug.s * r.constraint[i]
-                        } else {
-                            r.inertia[i] + r.force[i]
-                        };
+                self.asm.rate_residual(self.sys, &self.trial, aug, false);
+                let r = &self.asm.residual.constraint;
+                for &i in on.iter().filter(|&&i| self.sys.unknowns[i].is_multiplier()) {
+                    gradient[i] -= aug.s * (r[i] - tk.part[i]) / eps;
                 }
             }
             // In the treatment's unknowns (the blocks' `R` at the end, as `rhs`).
