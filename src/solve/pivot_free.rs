@@ -20,14 +20,6 @@ use crate::runtime::Pattern;
 /// factorization.
 pub const TINY: f64 = 1e-12;
 
-/// [`TINY`] in the order through one side ([`Rule::OneSide`]): a joint whose rows are nearly
-/// dependent on the side its multipliers followed meets a small pivot there, and the strict
-/// order is used instead of factors that grow as its inverse. The augmented Lagrangian's
-/// scaling keeps a sound pivot within a few orders of its column (the smallest measured over
-/// a run's first steps: 2.6e-5 on the elastic windmill, 2.7e-4 on a 100-link chain, 7.9e-4 on
-/// the rotating beam, 4.2e-2 on the two-bar, 5.3e-2 on the windmill).
-pub const ONE_SIDE_TINY: f64 = 1e-8;
-
 /// The update of a later supernode by one supernode's panels: rows `start..` of the source's
 /// rows below (those past the target's first column), of which the first `nj` are the
 /// target's own columns; `pos[p..p + ni]` places each in the target's rows.
@@ -52,10 +44,8 @@ pub struct PivotFree {
     /// Where each stored entry of the matrix goes in `x`, and its new column.
     dest: Vec<usize>,
     new_of: Vec<usize>,
-    /// The largest entry of each new column (and row), for the pivot test, and the share of
-    /// it a pivot must exceed.
+    /// The largest entry of each new column (and row), for the pivot test.
     scale: Vec<f64>,
-    tiny: f64,
     updates: Vec<Update>,
     updates_ptr: Vec<usize>,
     pos: Vec<usize>,
@@ -169,10 +159,6 @@ impl PivotFree {
             dest,
             new_of: inv,
             scale: vec![0.0; n],
-            tiny: match rule {
-                Rule::Strict => TINY,
-                Rule::OneSide => ONE_SIDE_TINY,
-            },
             updates,
             updates_ptr,
             pos,
@@ -230,7 +216,7 @@ impl PivotFree {
         let ut = &mut ut[..m * w];
         for k in 0..w {
             let p = l[k + k * ld];
-            if !p.is_finite() || p.abs() <= self.tiny * self.scale[f + k] {
+            if !p.is_finite() || p.abs() <= TINY * self.scale[f + k] {
                 return Err(TinyPivot(self.perm[f + k]));
             }
             let inv = 1.0 / p;
