@@ -3,8 +3,12 @@
 
 use super::PivotFree;
 
-/// Right-hand sides updated together by [`PivotFree::substitute_many`].
-const LANES: usize = 4;
+/// The most right-hand sides updated together by [`PivotFree::substitute_many`]. A pass over
+/// small supernodes is bound by the latency of its chain of dependent updates, not by its
+/// arithmetic, so a pass with more lanes costs little more than one with fewer: on the
+/// windmill's Floquet point (10 directions), one pass of 10 right-hand sides instead of passes
+/// of 4, 4 and 2 took 4.7 % off the whole point (criterion, 66.5 ms to 63.4 ms).
+const LANES: usize = 12;
 
 impl PivotFree {
     /// `rhs <- U^-1 L^-1 rhs`, in the original numbering.
@@ -79,11 +83,21 @@ impl PivotFree {
     /// call and is kept.
     pub fn substitute_many(&mut self, rhs: &mut [f64], count: usize) {
         let n = self.perm.len();
+        // Passes of equal width, as few as [`LANES`] allows.
+        let passes = count.div_ceil(LANES);
         let mut done = 0;
-        while done < count {
-            let lanes = (count - done).min(LANES);
+        for p in 0..passes {
+            let lanes = (count - done).div_ceil(passes - p);
             let cols = &mut rhs[done * n..(done + lanes) * n];
             match lanes {
+                12 => self.substitute_lanes::<12>(cols),
+                11 => self.substitute_lanes::<11>(cols),
+                10 => self.substitute_lanes::<10>(cols),
+                9 => self.substitute_lanes::<9>(cols),
+                8 => self.substitute_lanes::<8>(cols),
+                7 => self.substitute_lanes::<7>(cols),
+                6 => self.substitute_lanes::<6>(cols),
+                5 => self.substitute_lanes::<5>(cols),
                 4 => self.substitute_lanes::<4>(cols),
                 3 => self.substitute_lanes::<3>(cols),
                 2 => self.substitute_lanes::<2>(cols),
