@@ -190,14 +190,33 @@ fn exact_frame_columns_take_two_iterations_a_step_in_smooth_motion() {
         factored,
         1.02,
     );
-    // P3 at its step, 0.05 s, 50 s: measured 4.32 iterations a step (those of the attempts
-    // that converged), 3.97 factorizations a step, 3 halvings; the columns before took 10.74
-    // iterations, 10.83 factorizations and 8 halvings.
+    // P3 at its step, 0.05 s, 50 s: measured 3.73 iterations a step (those of the attempts
+    // that converged), 3.36 factorizations a step, no halving, with the predictor chosen by the
+    // last step (`Predictor`); the acceleration predictor alone took 4.32, 3.97 and 3
+    // halvings, and the columns before 10.74, 10.83 and 8.
     let p3 = two_bar_stats(&[], 0.05, 50.0);
     let per_step = p3.newton_iterations as f64 / p3.steps as f64;
     let factored = p3.factorizations as f64 / p3.steps as f64;
     eprintln!("P3: {per_step:.3} iterations, {factored:.3} factorizations a step");
-    within("iterations a step, P3 at 0.05 s", per_step, 4.6);
-    within("factorizations a step, P3 at 0.05 s", factored, 4.3);
-    within("halvings, P3 at 0.05 s", p3.halvings as f64, 4.0);
+    within("iterations a step, P3 at 0.05 s", per_step, 3.9);
+    within("factorizations a step, P3 at 0.05 s", factored, 3.5);
+    assert_eq!(p3.halvings, 0, "halvings, P3 at 0.05 s");
+    // The motion after the load reversal is chaotic at this step: the steps next to it take
+    // other paths. Measured 3.78, 3.76 and 3.69 iterations a step at 0.0498, 0.0499 and
+    // 0.0501 s, none halved (4.17 to 3.91 with 2, 11 and 1 halvings before); 0.0497 and
+    // 0.0502 s halve 5 and 7 times (3 and 5 before).
+    for dt in [0.0498, 0.0499, 0.0501] {
+        let near = two_bar_stats(&[], dt, 50.0);
+        let per_step = near.newton_iterations as f64 / near.steps as f64;
+        eprintln!(
+            "P3 at {dt} s: {per_step:.3} iterations a step, {} halvings",
+            near.halvings
+        );
+        within(&format!("iterations a step, P3 at {dt} s"), per_step, 3.9);
+        within(
+            &format!("halvings, P3 at {dt} s"),
+            near.halvings as f64,
+            3.0,
+        );
+    }
 }

@@ -231,8 +231,8 @@ fn two_bar_stability_study_finds_the_onset_without_dissipation_only() {
     assert_eq!(rows.len(), 2);
     let text = stdout(&o);
     // alpha = 0 (no dissipation): the acceleration blows up. The paper saw it at 22 s; this
-    // runtime's alternating acceleration takes off at 10.7 s and Newton fails at 11.7 s
-    // (2026-05: recorded as observed).
+    // runtime's alternating acceleration takes off at 11.45 s and Newton fails at 12.35 s
+    // (2026-12: recorded as observed; 10.7 s and 11.7 s in 2026-05).
     let (zero, damped) = (&rows[0], &rows[1]);
     assert_eq!(
         (zero[0].as_str(), zero[1].as_str(), zero[3].as_str()),

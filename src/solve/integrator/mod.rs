@@ -119,6 +119,8 @@ pub struct Integrator<'s> {
     predicted: Vec<[f64; 6]>,
     /// Whether the step's last Newton iteration headed for another root ([`TRUST`]).
     far: bool,
+    /// The predictor a step tries first: the one that came nearer the last step's solution.
+    predictor: Predictor,
     /// Every rotating node a frame (no beam nodes): `newton = full` may then keep a step's
     /// matrix after a small correction ([`Newton::quadratic`]). Beam models keep new
     /// matrices: the stiff-beam two-bar at the paper's step is chaotic, and whether it runs
@@ -230,6 +232,7 @@ impl<'s> Integrator<'s> {
             rate_maps: vec![([0.0; 36], [0.0; 36]); nodes],
             predicted: vec![[0.0; 6]; nodes],
             far: false,
+            predictor: Predictor::Acceleration,
             rigid: (0..nodes).all(|k| sys.is_frame(k)),
             exact_rates: false,
             cur: sys.initial.clone(),
@@ -515,6 +518,14 @@ impl<'s> Integrator<'s> {
         if self.method == Method::Fet {
             self.fet_commit(h)
         } else {
+            if self.method != Method::Static {
+                let [acceleration, velocity] = self.predictor_misses(h);
+                self.predictor = if velocity < acceleration {
+                    Predictor::Velocity
+                } else {
+                    Predictor::Acceleration
+                };
+            }
             self.newmark_commit()
         }
     }

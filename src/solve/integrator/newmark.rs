@@ -85,6 +85,23 @@ impl Scheme {
         )
     }
 
+    /// A step's increment of one unknown from its rate, acceleration and algorithmic
+    /// acceleration at the step's start, as `predictor` predicts it.
+    pub(super) fn predicted(
+        &self,
+        h: f64,
+        predictor: Predictor,
+        (v, a, alg0): (f64, f64, f64),
+    ) -> f64 {
+        match predictor {
+            Predictor::Velocity => h * v,
+            Predictor::Acceleration => {
+                let alg = (a - self.am * alg0) / (1.0 - self.am);
+                h * v + h * h * ((0.5 - self.beta) * alg0 + self.beta * alg)
+            }
+        }
+    }
+
     /// `d a_{n+1} / d q_{n+1}`.
     fn mass_coefficient(&self, h: f64) -> f64 {
         (1.0 - self.am) / ((1.0 - self.af) * self.beta * h * h)
@@ -111,13 +128,10 @@ impl Integrator<'_> {
         let (cur, tr) = (&self.cur, &mut self.trial);
         tr.t = cur.t + h;
         let step = |v: f64, a: f64, alg0: f64| {
-            let alg = (a - sc.am * alg0) / (1.0 - sc.am);
             if hold {
                 0.0
-            } else if predictor == Predictor::Velocity {
-                h * v
             } else {
-                h * v + h * h * ((0.5 - sc.beta) * alg0 + sc.beta * alg)
+                sc.predicted(h, predictor, (v, a, alg0))
             }
         };
         for i in 0..n {
@@ -153,6 +167,39 @@ impl Integrator<'_> {
             *p = f.v.map(|v| h * v);
         }
         self.newmark(h);
+    }
+
+    /// How far each predictor's step lies from the converged step, before the commit: the
+    /// largest difference over the unknowns, scaled as Newton's increments are, as
+    /// `[acceleration, velocity]`.
+    pub(super) fn predictor_misses(&self, h: f64) -> [f64; 2] {
+        const BOTH: [Predictor; 2] = [Predictor::Acceleration, Predictor::Velocity];
+        let (cur, sys, sc) = (&self.cur, self.sys, self.sc);
+        let mut miss = [0.0f64; 2];
+        let mut count = |taken: f64, rates: (f64, f64, f64), scale: f64| {
+            for (m, p) in miss.iter_mut().zip(BOTH) {
+                *m = m.max((taken - sc.predicted(h, p, rates)).abs() * scale);
+            }
+        };
+        for i in (0..sys.len()).filter(|&i| !self.in_frame[i]) {
+            let scale = match sys.unknowns[i] {
+                UnknownKind::Rotation { .. } => 1.0,
+                UnknownKind::Coordinate => 1.0 / sys.length_scale,
+                _ => continue,
+            };
+            count(self.step_q[i], (cur.v[i], cur.a[i], cur.alg[i]), scale);
+        }
+        if self.layout == Layout::Increments {
+            for (k, (f, taken)) in cur.frames.iter().zip(&self.step_frames).enumerate() {
+                // Translations of nodes that are not frames are coordinates, counted above.
+                let first = if sys.is_frame(k) { 0 } else { 3 };
+                for j in first..6 {
+                    let scale = if j < 3 { 1.0 / sys.length_scale } else { 1.0 };
+                    count(taken[j], (f.v[j], f.dv[j], f.alg[j]), scale);
+                }
+            }
+        }
+        miss
     }
 
     /// The residual at the iterate, in `rhs` in the treatment's unknowns, and its norms.

@@ -8,13 +8,29 @@ use crate::runtime::rotation::V3;
 use crate::settings::{Method, NewtonMode};
 use crate::solve::FailureKind;
 
-/// Where a step's Newton iteration starts.
+/// Where a step's Newton iteration starts. A step tries first the predictor that came nearer
+/// the last step's solution (`Integrator::predictor_misses`): the acceleration unchanged in
+/// smooth motion (third order), the velocity unchanged where the accelerations alternate from
+/// step to step. On the paper's two-bar at 0.05 s the accelerations alternate after the load
+/// reversal (at 18.5 s the acceleration predictor misses the hinge by 0.16 m, the velocity
+/// predictor by 0.07 m): 3.73 Newton iterations a step and no halving, against 4.32 and 3 from
+/// the acceleration predictor alone.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Predictor {
     /// The acceleration unchanged (statics: the last load step's equilibrium).
     Acceleration,
     /// The velocity unchanged, for a step too long for the accelerations' changes.
     Velocity,
+}
+
+impl Predictor {
+    /// The predictor a step falls back on.
+    pub(super) fn other(self) -> Predictor {
+        match self {
+            Predictor::Acceleration => Predictor::Velocity,
+            Predictor::Velocity => Predictor::Acceleration,
+        }
+    }
 }
 
 /// The farthest a frame's iterate may turn from the step at constant velocities (rad): beyond
@@ -68,21 +84,19 @@ impl Integrator<'_> {
     }
 
     /// One step of size `h` from `cur`; on success `cur` holds the new state. The Newmark
-    /// family predicts the acceleration unchanged; when Newton heads from there for another
-    /// root of the step's equations ([`TRUST`]), the step starts again from constant
-    /// velocities before it is halved. (Starting again from constant velocities after any
-    /// failure spares the paper's two-bar its 3 halvings but lands, at 18.4 s, on a motion
-    /// whose acceleration doubles, against the paper's bounded one at alpha -0.1; and it
-    /// costs the stiff-beam two-bar 52 more halvings: a stiff element's velocities carry its
-    /// vibration.)
+    /// family starts from the [`Predictor`] that served the last step best; when Newton heads
+    /// from there for another root of the step's equations ([`TRUST`]), the step starts again
+    /// from the other predictor before it is halved. (Starting again from constant velocities
+    /// after any failure costs the stiff-beam two-bar 52 more halvings: a stiff element's
+    /// velocities carry its vibration.)
     pub(super) fn attempt(&mut self, h: f64) -> Result<(), StepFailure> {
         self.far = false;
-        let first = self.newton(h, Predictor::Acceleration);
+        let first = self.newton(h, self.predictor);
         if first.is_ok() || !self.far {
             return first;
         }
         self.stats.repredictions += 1;
-        self.newton(h, Predictor::Velocity)
+        self.newton(h, self.predictor.other())
     }
 
     /// The Newton iteration of one step from the predictor.
