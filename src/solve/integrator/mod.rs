@@ -42,6 +42,12 @@ use step::Predictor;
 /// Largest rotation of a node in one Newton correction (rad).
 const MAX_TURN: f64 = 0.5;
 
+/// Newton iterations within which a beam model's step counts as smooth, so that the next step
+/// may keep its matrix after a small correction (`Integrator::smooth`): the elastic windmill
+/// converges in 2 a step (factorizations 12,000 -> 6,045 over its 3-s run with the matrix
+/// kept); the stiff-beam two-bar at 0.05 s needs 11 and keeps new matrices.
+const SMOOTH: usize = 2;
+
 /// How the rotation unknowns are held.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Layout {
@@ -122,11 +128,14 @@ pub struct Integrator<'s> {
     /// The predictor a step tries first: the one that came nearer the last step's solution.
     predictor: Predictor,
     /// Every rotating node a frame (no beam nodes): `newton = full` may then keep a step's
-    /// matrix after a small correction ([`Newton::quadratic`]). Beam models keep new
-    /// matrices: the stiff-beam two-bar at the paper's step is chaotic, and whether it runs
-    /// its 50 s depends on the iteration path (with the matrix kept it fails at 17 s, as
+    /// matrix after a small correction ([`Newton::quadratic`]). Beam models keep it only
+    /// while their steps converge in [`SMOOTH`] iterations (`smooth`): the stiff-beam two-bar
+    /// at the paper's step (11 iterations a step) is chaotic, and whether it runs its 50 s
+    /// depends on the iteration path (with the matrix always kept it fails at 17 s, as
     /// without it at alpha -0.09 or -0.12).
     rigid: bool,
+    /// The last step converged in at most [`SMOOTH`] Newton iterations.
+    smooth: bool,
     /// Beam nodes' columns exact too (their rates' dependence on the correction,
     /// [`se3::rate_maps`]): for the step's tangent. Newton leaves them out (a linear
     /// contraction on beam models, measured to keep the stiff-beam two-bar on its motion).
@@ -234,6 +243,7 @@ impl<'s> Integrator<'s> {
             far: false,
             predictor: Predictor::Acceleration,
             rigid: (0..nodes).all(|k| sys.is_frame(k)),
+            smooth: false,
             exact_rates: false,
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
@@ -510,6 +520,7 @@ impl<'s> Integrator<'s> {
     /// The step's end: the counts, and the converged iterate made current.
     fn converge(&mut self, it: usize, cnorm: f64, aug: Augment, h: f64) -> Result<(), StepFailure> {
         self.stats.newton_iterations += it;
+        self.smooth = it <= SMOOTH;
         self.stats.max_constraint_violation = self.stats.max_constraint_violation.max(cnorm);
         self.aug = aug;
         self.lambda_prev.0.copy_from_slice(&self.cur.lambda);

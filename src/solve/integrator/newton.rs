@@ -24,7 +24,8 @@ pub(super) struct Newton {
 /// correction at most this large (scaled): the matrix then differs from one made at the new
 /// iterate by about this much, relative, and contracts the next correction about as far (the
 /// two-bar at 1 ms over 50 s: 1.18 factorizations for 2.04 iterations a step, against 2.02
-/// and 2.02). Systems with beam nodes keep new matrices (`Integrator::rigid`).
+/// and 2.02). Beam models keep it only while their steps converge in two iterations
+/// (`Integrator::smooth`).
 const WITHIN: f64 = 1e-6;
 
 /// A kept matrix's step is converged only when the geometric tail of its corrections (what the

@@ -93,10 +93,13 @@ impl Integrator<'_> {
         self.far = false;
         let first = self.newton(h, self.predictor);
         if first.is_ok() || !self.far {
+            self.smooth &= first.is_ok();
             return first;
         }
         self.stats.repredictions += 1;
-        self.newton(h, self.predictor.other())
+        let second = self.newton(h, self.predictor.other());
+        self.smooth &= second.is_ok();
+        second
     }
 
     /// The Newton iteration of one step from the predictor.
@@ -142,7 +145,7 @@ impl Integrator<'_> {
                 });
             }
             let keep = if self.reuse.mode() == NewtonMode::Full {
-                self.rigid && newton.quadratic()
+                (self.rigid || self.smooth) && newton.quadratic()
             } else {
                 self.kept == Some(h) && newton.rate() <= keep_rate
             };
