@@ -18,6 +18,9 @@ pub(super) struct Newton {
     growth: usize,
     /// Whether the last correction came from a matrix made at its iterate.
     fresh: bool,
+    /// A kept matrix is as good as new (`newton = full` keeps one only after a correction of
+    /// at most [`WITHIN`]).
+    pub(super) as_new: bool,
 }
 
 /// `newton = full` keeps the step's matrix for the next correction after a new matrix's
@@ -46,6 +49,7 @@ impl Newton {
             last: f64::INFINITY,
             growth: 0,
             fresh: true,
+            as_new: false,
         }
     }
 
@@ -57,17 +61,20 @@ impl Newton {
     /// residual must be small and the contraction's tail below [`TAIL`] of the tolerance.
     pub(super) fn converged(&self, rnorm: f64, scale: f64, cnorm: f64) -> bool {
         let small = self.increment_ok && cnorm <= self.ltol;
+        let noise = self.last_increment <= 1e-3 * self.atol;
         if !self.fresh {
             let rate = self.rate();
-            let tail = self.last_increment <= 1e-3 * self.atol
+            let tail = noise
                 || (rate > 0.0 && rate < 1.0)
                     && self.last_increment * rate / (1.0 - rate) <= TAIL * self.atol;
-            return small && tail && rnorm <= self.rtol * scale;
+            // A matrix kept as good as new (`full`) settles as a new one does: at an
+            // increment at round-off the residual is at its noise.
+            let settled = rnorm <= self.rtol * scale || (self.as_new && noise);
+            return small && tail && settled;
         }
         let stalled =
             self.last_increment <= self.atol && self.last_increment > 0.1 * self.previous_increment;
-        let settled =
-            rnorm <= self.rtol * scale || self.last_increment <= 1e-3 * self.atol || stalled;
+        let settled = rnorm <= self.rtol * scale || noise || stalled;
         // The contraction measured over the last two corrections bounds what is left: a
         // correction above the tolerance may end the step when its tail is below TAIL of it.
         let theta = self.last_increment / self.previous_increment;

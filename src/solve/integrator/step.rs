@@ -115,6 +115,7 @@ impl Integrator<'_> {
             self.newmark_predict(h, rescale, keep_rate > 0.0, predictor);
         }
         let mut newton = Newton::new(&self.set, self.sys);
+        newton.as_new = self.reuse.mode() == NewtonMode::Full;
         let max = self.set.max_iterations;
         // Whether the last correction came from a kept matrix, and the residual's total
         // before it.
