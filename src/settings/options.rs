@@ -99,7 +99,7 @@ impl Start {
 pub enum NewtonMode {
     /// A new iteration matrix at every iteration (the default); in models without beams, and
     /// in beam models while their steps converge in two iterations, a correction of at most
-    /// 1e-6 is followed by one with the step's matrix, then as good as new.
+    /// 1e-5 is followed by one with the step's matrix, then as good as new.
     #[default]
     Full,
     /// The factored matrix kept across iterations and steps while each correction it makes
