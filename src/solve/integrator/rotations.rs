@@ -75,8 +75,11 @@ pub fn tangents(sys: &System, st: &State, out: &mut [M3]) {
 /// except for 3x3 blocks starting at given unknowns (`H_k` of the conformal treatment, `R_k`
 /// of the SE(3) one). Precomputed once per pattern.
 pub struct Transform {
-    /// Block starting at this unknown.
-    first_of: Vec<Option<usize>>,
+    /// The columns where a block starts, with the block's index.
+    columns: Vec<(usize, usize)>,
+    /// The entries of the pattern where a block's rows start (the next two entries of the
+    /// column are its other rows), with the block's index: the rows' pass visits them alone.
+    rows: Vec<(usize, usize)>,
 }
 
 impl Transform {
@@ -112,14 +115,20 @@ impl Transform {
                 }
             }
         }
-        Some(Transform { first_of })
+        let columns = (0..p.n)
+            .filter_map(|c| first_of[c].map(|k| (c, k)))
+            .collect();
+        let rows = (0..p.row_idx.len())
+            .filter(|&i| member[p.row_idx[i]] == 0)
+            .filter_map(|i| first_of[p.row_idx[i]].map(|k| (i, k)))
+            .collect();
+        Some(Transform { columns, rows })
     }
 
     /// `L^T J T` with `L` from `left` and `T` from `right` (block matrices by block index).
     pub fn apply(&self, p: &Pattern, values: &mut [f64], left: &[M3], right: &[M3]) {
         // Columns: J <- J T.
-        for c in 0..p.n {
-            let Some(k) = self.first_of[c] else { continue };
+        for &(c, k) in &self.columns {
             let (s0, s1, s2) = (p.col_ptr[c], p.col_ptr[c + 1], p.col_ptr[c + 2]);
             let len = s1 - s0;
             for r in 0..len {
@@ -131,21 +140,12 @@ impl Transform {
             }
         }
         // Rows: J <- T^T J.
-        for c in 0..p.n {
-            let (a, b) = (p.col_ptr[c], p.col_ptr[c + 1]);
-            let mut i = a;
-            while i < b {
-                if let Some(k) = self.first_of[p.row_idx[i]] {
-                    let x = V3::new(values[i], values[i + 1], values[i + 2]);
-                    let y = left[k].transpose() * x;
-                    values[i] = y[0];
-                    values[i + 1] = y[1];
-                    values[i + 2] = y[2];
-                    i += 3;
-                } else {
-                    i += 1;
-                }
-            }
+        for &(i, k) in &self.rows {
+            let x = V3::new(values[i], values[i + 1], values[i + 2]);
+            let y = left[k].transpose() * x;
+            values[i] = y[0];
+            values[i + 1] = y[1];
+            values[i + 2] = y[2];
         }
     }
 }
