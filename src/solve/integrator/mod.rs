@@ -101,6 +101,8 @@ pub struct Integrator<'s> {
     /// The multipliers of the step before the current one, and the size of the last two steps
     /// when they were equal.
     lambda_prev: (Vec<f64>, Option<f64>),
+    /// The multipliers of the step before that, and whether the last three steps were equal.
+    lambda_prev2: (Vec<f64>, bool),
     last_h: Option<f64>,
     /// Whether each step may keep the matrix (`newton = auto` decides step by step).
     reuse: Reuse,
@@ -229,6 +231,7 @@ impl<'s> Integrator<'s> {
             saved_steps: (vec![0.0; n], vec![[0.0; 6]; nodes]),
             reuse: Reuse::new(set.newton, set.method),
             lambda_prev: (vec![0.0; n], None),
+            lambda_prev2: (vec![0.0; n], false),
             last_h: None,
             mass_lu: None,
             transform,
@@ -523,6 +526,8 @@ impl<'s> Integrator<'s> {
         self.smooth = it <= SMOOTH;
         self.stats.max_constraint_violation = self.stats.max_constraint_violation.max(cnorm);
         self.aug = aug;
+        std::mem::swap(&mut self.lambda_prev.0, &mut self.lambda_prev2.0);
+        self.lambda_prev2.1 = self.lambda_prev.1 == Some(h) && self.last_h == Some(h);
         self.lambda_prev.0.copy_from_slice(&self.cur.lambda);
         self.lambda_prev.1 = (self.last_h == Some(h)).then_some(h);
         self.last_h = Some(h);

@@ -123,6 +123,7 @@ impl Integrator<'_> {
         for it in 0..=max {
             let mut r = self.residual(fet, h, aug, newton.floor)?;
             let mut total = r.force + aug.s * r.constraint;
+            newton.residual_rate = total / last_total;
             if newton.converged(r.force, r.scale, r.constraint) {
                 self.reuse
                     .end(it, self.stats.factorizations - factorizations);
