@@ -116,6 +116,9 @@ pub struct Integrator<'s> {
     mats: Vec<M3>,
     /// Unknowns moved by the SE(3) node updates instead of Newmark on coordinates.
     in_frame: Vec<bool>,
+    /// The unknowns that are not multipliers, and those of them not in a frame (the flat
+    /// slots of the step's tangent, `tangent::flat`): listed once for its loops.
+    coords: (Vec<usize>, Vec<usize>),
     /// The step's increment so far: of each coordinate (not in a frame), and of each node's
     /// frame (body-frame `(u, theta)`; rotation only for nodes that are not frames).
     step_q: Vec<f64>,
@@ -216,6 +219,10 @@ impl<'s> Integrator<'s> {
                 in_frame[f..f + 3].iter_mut().for_each(|x| *x = true);
             }
         }
+        let coords: Vec<usize> = (0..n)
+            .filter(|&i| !sys.unknowns[i].is_multiplier())
+            .collect();
+        let flat = coords.iter().copied().filter(|&i| !in_frame[i]).collect();
         let mut it = Integrator {
             sys,
             set: set.clone(),
@@ -239,6 +246,7 @@ impl<'s> Integrator<'s> {
             blocks,
             block_node,
             in_frame,
+            coords: (coords, flat),
             step_q: vec![0.0; n],
             step_frames: vec![[0.0; 6]; nodes],
             rate_maps: vec![([0.0; 36], [0.0; 36]); nodes],

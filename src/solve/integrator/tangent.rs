@@ -186,11 +186,10 @@ pub(super) fn physical_rates(
     let n = sys.len();
     dv.fill(0.0);
     da.fill(0.0);
-    for c in 0..count {
-        let dir = &dirs[c * 4 * n..(c + 1) * 4 * n];
-        for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
-            dv[c * n + i] = dir[n + i];
-            da[c * n + i] = dir[2 * n + i];
+    for i in (0..n).filter(|&i| flat(sys, in_frame, i)) {
+        for c in 0..count {
+            dv[c * n + i] = dirs[c * 4 * n + n + i];
+            da[c * n + i] = dirs[c * 4 * n + 2 * n + i];
         }
     }
     for k in 0..sys.rotations.len() {
@@ -414,7 +413,7 @@ impl Integrator<'_> {
         let n = self.sys.len();
         let g = |x: &[f64], i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
         out.iter_mut().for_each(|x| *x = 0.0);
-        for i in (0..n).filter(|&i| !self.sys.unknowns[i].is_multiplier()) {
+        for &i in &self.coords.0 {
             let (v, a, alg) = (dir[n + i], dir[2 * n + i], dir[3 * n + i]);
             for (k, c) in coef.iter().enumerate() {
                 out[(k + 1) * n + i] = c[1] * v + c[2] * a + c[3] * alg;
@@ -453,7 +452,7 @@ impl Integrator<'_> {
             out[2 * n + s] += coef[1][0] * d;
             out[3 * n + s] += coef[2][0] * d;
         };
-        for i in (0..n).filter(|&i| flat(self.sys, &self.in_frame, i)) {
+        for &i in &self.coords.1 {
             add(out, i, x[i]);
         }
         let g = |i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
@@ -493,8 +492,8 @@ impl Integrator<'_> {
         self.node_maps(&mut tk.nodes);
         let coef = self.coefficients(h);
         tk.gradients.iter_mut().for_each(|x| *x = 0.0);
-        // The perturbed states below differ from the end's in their rates alone.
-        self.trial.assign(&self.cur);
+        // The perturbed states below differ from the end's (`trial`, which the matrix only
+        // read) in their rates alone.
         // The elements with inertia through their derivatives, assembled once a step.
         self.asm.rate_jacobians(self.sys, &self.cur, aug);
         for c in 0..tk.count {
