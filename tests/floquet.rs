@@ -94,11 +94,15 @@ fn the_tangent_monodromy_of_the_windmill_is_that_of_perturbed_runs() {
             exponent_difference(&t, &r),
             s_bound,
         );
-        // One run of the period and the settling steps (1,020 steps) against 4 n_f + 1 runs
-        // of a period (905 steps each): measured 2,947 against 28,938 Newton iterations.
+        // One run of the period and the 115 settling steps (HHT at alpha -0.1 damps by 0.82 a
+        // step) against 4 n_f + 1 runs of a period, and one Newton correction a step (the
+        // multipliers' quadratic extrapolation; two before it): measured 1,496 iterations
+        // over 1,473 steps against 28,959 at 1.0, and 1,043 over 1,020 against 19,425 at 1.5.
+        let steps = (t.steps + 115) as f64;
         assert!(
-            t.newton_iterations * 8 < r.newton_iterations,
-            "{} vs {}",
+            (t.newton_iterations as f64) < 1.1 * steps
+                && t.newton_iterations * 15 < r.newton_iterations,
+            "{} iterations over {steps} steps vs {}",
             t.newton_iterations,
             r.newton_iterations
         );
