@@ -61,6 +61,7 @@
 mod harmonics;
 mod krylov;
 mod space;
+mod tangent;
 
 use super::integrator::Integrator;
 use super::integrator::DEAD;
@@ -104,6 +105,9 @@ pub struct Floquet {
     pub shapes: Vec<Vec<c64>>,
     /// Newton iterations over all runs.
     pub newton_iterations: usize,
+    /// Steps a run went on past the period for its directions' algorithmic part to die out
+    /// (0 without: an integrator that does not damp it, or perturbed runs).
+    pub settling: usize,
     /// How the monodromy matrix was built.
     pub how: Monodromy,
     /// Partial Floquet's account ([`Monodromy::Krylov`]; `monodromy` is empty then).
@@ -170,11 +174,12 @@ fn integrate(it: &mut Integrator) -> Result<State, RuntimeFailure> {
     Ok(it.state().clone())
 }
 
-/// Steps after which the integrator has damped a stiff mode's directions below
-/// [`DEAD`](crate::solve::integrator::DEAD) (its spectral radius at infinity to that power):
-/// the carried directions are deflated that often. 0 (never) for an integrator that does not
-/// damp them.
-fn deflation_steps(set: &Settings) -> usize {
+/// Steps after which the integrator has damped the algorithmic part of directions carrying
+/// at most `content` of it (of their weighted size) below
+/// [`DEAD`](crate::solve::integrator::DEAD): its spectral radius at infinity to that power
+/// reaches `DEAD / content`; the carried directions are deflated that often. 0 (never) for
+/// an integrator that does not damp them. A direction of unknown make-up has `content` 1.
+fn deflation_steps(set: &Settings, content: f64) -> usize {
     let rho = match set.method {
         Method::Hht => (1.0 + set.alpha) / (1.0 - set.alpha),
         Method::GeneralizedAlpha => set.rho_inf,
@@ -183,7 +188,12 @@ fn deflation_steps(set: &Settings) -> usize {
     if rho.is_nan() || rho >= 0.99 {
         return 0;
     }
-    (DEAD.ln() / rho.max(1e-3).ln()).ceil() as usize
+    let content = if content.is_finite() {
+        content.clamp(DEAD, 1.0)
+    } else {
+        1.0
+    };
+    ((DEAD / content).ln() / rho.max(1e-3).ln()).ceil().max(1.0) as usize
 }
 
 /// The settled projection's largest multiplier may exceed that of `Phi` (through the
@@ -238,10 +248,11 @@ pub fn floquet_by(
         z0,
         zt,
         newton_iterations,
+        settling,
         history,
         settled,
     } = match how {
-        Monodromy::Tangent => by_tangent(sys, &mut it, &space, progress)?,
+        Monodromy::Tangent => tangent::by_tangent(sys, &mut it, &space, progress)?,
         Monodromy::Runs => by_runs(sys, &mut it, &space, progress)?,
         Monodromy::Krylov(k) => return krylov::partial(sys, &mut it, &space, k, period, progress),
     };
@@ -327,6 +338,7 @@ pub fn floquet_by(
         frequencies,
         shapes,
         newton_iterations,
+        settling,
         how,
         partial: None,
     })
@@ -336,7 +348,7 @@ pub fn floquet_by(
 /// carries no tangent, the whole analysis where partial does not apply, partial where the whole
 /// one's directions would take more than [`PARTIAL_ABOVE_BYTES`].
 fn chosen(how: Monodromy, it: &Integrator, dim: usize) -> Monodromy {
-    let settle = deflation_steps(it.settings());
+    let settle = deflation_steps(it.settings(), 1.0);
     match how {
         _ if !it.can_track() => Monodromy::Runs,
         Monodromy::Krylov(k) if !krylov::applies(dim, k, settle) => Monodromy::Tangent,
@@ -356,6 +368,7 @@ struct Columns {
     z0: DMatrix<f64>,
     zt: DMatrix<f64>,
     newton_iterations: usize,
+    settling: usize,
     history: Vec<(f64, DMatrix<f64>)>,
     /// From the tangent with a damping integrator: the discrete map's own monodromy.
     settled: Option<Settled>,
@@ -401,103 +414,6 @@ where
     Ok(z0)
 }
 
-/// The monodromy's columns from the step's tangent: the perturbed starts' directions carried
-/// through one run of the period (THEORY §9.2), measured at its end.
-fn by_tangent(
-    sys: &System,
-    it: &mut Integrator,
-    space: &Space,
-    progress: &dyn Fn(),
-) -> Result<Columns, FloquetFailure> {
-    let reference_failure = |failure| FloquetFailure { run: None, failure };
-    let n = space.dim();
-    let dim = it.direction_len();
-    let mut directions = vec![0.0; n * dim];
-    let mut diff = vec![0.0; dim];
-    // Each start's difference from the reference start in the step's state layout.
-    let z0 = starts(sys, it, space, |it, dir, sign| {
-        it.state_difference(it.state(), &space.start, &mut diff);
-        let col = &mut directions[dir * dim..(dir + 1) * dim];
-        for (c, d) in col.iter_mut().zip(&diff) {
-            *c += sign * d / (2.0 * EPSILON);
-        }
-        Ok(())
-    })?;
-    it.restart(&sys.initial).map_err(reference_failure)?;
-    it.track(directions, 1.0 / space.omega);
-    // With a damping integrator, the run goes on past the period by the settling steps, and
-    // the period is measured again from them (`Settled`).
-    let (period, settle) = (it.steps(), deflation_steps(it.settings()));
-    it.deflate_every(settle, true);
-    it.extend_run(settle);
-    // The directions' measure at evenly spaced steps, for the modes' time histories.
-    let stride = (period / harmonics::SAMPLES).max(1);
-    let (t0, mut history) = (it.state().t, Vec::new());
-    history.push((0.0, z0.clone()));
-    let mut zt = None;
-    let (mut from, mut settled) = (None, None);
-    let mut rr_history = Vec::new();
-    it.run(|k, it| {
-        let t = it.state().t;
-        // (The settled history replaces it.)
-        if settle == 0 && k % stride == 0 && k < period {
-            history.push((t - t0, carried_measure(sys, it, space, it.state())));
-        }
-        if k == period {
-            zt = Some(carried_measure(sys, it, space, it.state()));
-        }
-        match from {
-            None if it.is_settled() => {
-                from = Some((k, t));
-                rr_history.push((0.0, carried_settled(sys, it, space)));
-            }
-            Some((s, ts)) if k - s < period && (k - s) % stride == 0 => {
-                rr_history.push((t - ts, carried_settled(sys, it, space)));
-            }
-            Some((s, _)) if k - s == period => {
-                settled = it.settled_monodromy();
-            }
-            _ => {}
-        }
-        Ok::<(), Infallible>(())
-    })
-    .map_err(|s| match s {
-        Stop::Failed(f) => reference_failure(f),
-        Stop::Stopped(never) => match never {},
-    })?;
-    progress();
-    let zt = zt.unwrap_or_else(|| carried_measure(sys, it, space, it.state()));
-    let settled = settled.and_then(|c| {
-        let z = rr_history.first()?.1.clone();
-        Some(Settled {
-            c,
-            z,
-            history: rr_history,
-        })
-    });
-    Ok(Columns {
-        z0,
-        zt,
-        newton_iterations: it.stats().newton_iterations,
-        history,
-        settled,
-    })
-}
-
-/// The measure of the carried directions at the integrator's current state `reference`.
-fn carried_measure(
-    sys: &System,
-    it: &Integrator,
-    space: &Space,
-    reference: &State,
-) -> DMatrix<f64> {
-    let raw = carried_raw(sys, it, space, reference);
-    let n = raw.ncols();
-    let map = it.tracked_map().unwrap_or_default();
-    let given = map.len() / n.max(1);
-    raw * DMatrix::from_column_slice(n, given, map)
-}
-
 /// The measure of each carried column at the integrator's current state `reference`.
 fn carried_raw(sys: &System, it: &Integrator, space: &Space, reference: &State) -> DMatrix<f64> {
     let (dim, nfree) = (it.direction_len(), space.free.len());
@@ -536,15 +452,6 @@ fn carried_raw(sys: &System, it: &Integrator, space: &Space, reference: &State) 
     space.project(&dq, &dv)
 }
 
-/// The measure of the settled directions' images now (`integrator/deflate.rs`).
-fn carried_settled(sys: &System, it: &Integrator, space: &Space) -> DMatrix<f64> {
-    let raw = carried_raw(sys, it, space, it.state());
-    let since = it.settled_images().unwrap_or_default();
-    let n = raw.ncols();
-    let r = since.len() / n.max(1);
-    raw * DMatrix::from_column_slice(n, r, since)
-}
-
 /// The monodromy's columns from `4 n_f` perturbed runs of one period.
 fn by_runs(
     sys: &System,
@@ -574,6 +481,7 @@ fn by_runs(
         z0,
         zt,
         newton_iterations,
+        settling: 0,
         history: Vec::new(),
         settled: None,
     })

@@ -83,7 +83,7 @@ pub(super) fn by_krylov(
 ) -> Result<Krylov, FloquetFailure> {
     let reference_failure = |failure| FloquetFailure { run: None, failure };
     let (n, dim) = (space.dim(), it.direction_len());
-    let (period, settle) = (it.steps(), deflation_steps(it.settings()));
+    let (period, settle) = (it.steps(), deflation_steps(it.settings(), 1.0));
     let b = block_size(wanted);
     let tau = 1.0 / space.omega;
     let lifted = lifted_block(sys, it, space, b)?;
@@ -315,6 +315,7 @@ pub(super) fn partial(
         frequencies,
         shapes,
         newton_iterations: k.newton_iterations,
+        settling: deflation_steps(it.settings(), 1.0),
         how: Monodromy::Krylov(wanted),
         partial: Some(Partial {
             wanted,
