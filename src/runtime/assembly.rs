@@ -78,6 +78,8 @@ pub struct Assembler {
     /// Per element of `reading.0`, its local `M` then `C` (row-major, `nl x nl` each) at the
     /// state of the last [`Assembler::rate_jacobians`]; sized on its first call.
     rate_local: Vec<f64>,
+    /// Per element, where its `M` starts in `rate_local` (elements of `reading.0`).
+    rate_at: Vec<Option<usize>>,
     /// [`Assembler::rate_products`]' workspace: an element's rates, all directions.
     rate_work: Vec<f64>,
     pub residual: Residual,
@@ -121,6 +123,12 @@ impl Assembler {
             all
         };
         let rate_support = (support(&[&reading.1]), support(&[&reading.0, &reading.1]));
+        let mut rate_at = vec![None; sys.elements.len()];
+        let mut at = 0;
+        for &e in &reading.0 {
+            rate_at[e] = Some(at);
+            at += 2 * indices[e].len().pow(2);
+        }
         Assembler {
             pattern,
             values,
@@ -132,6 +140,7 @@ impl Assembler {
             reading,
             rate_support,
             rate_local: Vec::new(),
+            rate_at,
             rate_work: Vec::new(),
             residual: Residual::new(n),
             momentum: vec![0.0; n],
@@ -184,7 +193,32 @@ impl Assembler {
         maps: &[([f64; 36], [f64; 36])],
         frames_only: bool,
     ) {
-        let rates = |mass: f64, velocity: f64| TangentCoeffs {
+        self.rate_columns(sys, (st, aug, force_weight), maps, frames_only, false);
+    }
+
+    /// [`Assembler::add_rate_columns`] with the `M` and `C` of the last
+    /// [`Assembler::rate_jacobians`] (its state and penalty, unit force weight) where it holds
+    /// them, instead of evaluating them again.
+    pub fn add_kept_rate_columns(
+        &mut self,
+        sys: &System,
+        st: &State,
+        aug: Augment,
+        maps: &[([f64; 36], [f64; 36])],
+        frames_only: bool,
+    ) {
+        self.rate_columns(sys, (st, aug, 1.0), maps, frames_only, true);
+    }
+
+    fn rate_columns(
+        &mut self,
+        sys: &System,
+        (st, aug, w): (&State, Augment, f64),
+        maps: &[([f64; 36], [f64; 36])],
+        frames_only: bool,
+        kept: bool,
+    ) {
+        let rates = |mass: f64, velocity: f64, force_weight: f64| TangentCoeffs {
             mass,
             velocity,
             position: 0.0,
@@ -198,12 +232,19 @@ impl Assembler {
             let (el, map) = (&sys.elements[*e], &self.maps[*e]);
             let nl2 = map.len();
             let nl = self.indices[*e].len();
-            el.tangent(st, aug, rates(1.0, 0.0), &mut self.local[..nl2]);
-            el.tangent(st, aug, rates(0.0, 1.0), &mut self.local2[..nl2]);
+            let held = self.rate_at[*e].filter(|&o| kept && o + 2 * nl2 <= self.rate_local.len());
+            let (m, c) = match held {
+                Some(o) => self.rate_local[o..o + 2 * nl2].split_at(nl2),
+                None => {
+                    el.tangent(st, aug, rates(1.0, 0.0, w), &mut self.local[..nl2]);
+                    el.tangent(st, aug, rates(0.0, 1.0, w), &mut self.local2[..nl2]);
+                    (&self.local[..nl2], &self.local2[..nl2])
+                }
+            };
             for (k, at) in nodes.iter().filter(|&&(k, _)| take(k)) {
                 let (ev, ea) = &maps[*k];
                 for i in 0..nl {
-                    let (m, c) = (&self.local[i * nl..], &self.local2[i * nl..]);
+                    let (m, c) = (&m[i * nl..], &c[i * nl..]);
                     for b in 0..6 {
                         let mut sum = 0.0;
                         for (a, &la) in at.iter().enumerate() {

@@ -43,6 +43,8 @@ pub struct PivotFree {
     x: Vec<f64>,
     /// Where each stored entry of the matrix goes in `x`, and its new column.
     dest: Vec<usize>,
+    /// The places in `x` no entry goes to (the fill), zeroed before each factorization.
+    fill: Vec<usize>,
     new_of: Vec<usize>,
     /// The largest entry of each new column (and row), for the pivot test.
     scale: Vec<f64>,
@@ -122,6 +124,11 @@ impl PivotFree {
                 dest.push(d);
             }
         }
+        let mut covered = vec![false; size];
+        for &d in &dest {
+            covered[d] = true;
+        }
+        let fill = (0..size).filter(|&d| !covered[d]).collect();
         let (mut updates, mut updates_ptr, mut pos) = (Vec::new(), vec![0], Vec::new());
         let mut tmp_len = 0;
         for t in 0..ns {
@@ -157,6 +164,7 @@ impl PivotFree {
             u_at,
             x: vec![0.0; size],
             dest,
+            fill,
             new_of: inv,
             scale: vec![0.0; n],
             updates,
@@ -183,7 +191,9 @@ impl PivotFree {
     /// Factors the matrix with the analysed pattern and `values`.
     pub fn factor(&mut self, values: &[f64]) -> Result<(), TinyPivot> {
         self.a.copy_from_slice(values);
-        self.x.fill(0.0);
+        for &d in &self.fill {
+            self.x[d] = 0.0;
+        }
         self.scale.fill(0.0);
         for (j, &c) in self.new_of.iter().enumerate() {
             let (lo, hi) = (self.col_ptr[j], self.col_ptr[j + 1]);

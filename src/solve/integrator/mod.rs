@@ -145,6 +145,9 @@ pub struct Integrator<'s> {
     /// [`se3::rate_maps`]): for the step's tangent. Newton leaves them out (a linear
     /// contraction on beam models, measured to keep the stiff-beam two-bar on its motion).
     exact_rates: bool,
+    /// The assembler holds the elements' `M` and `C` at the iterate
+    /// ([`crate::runtime::Assembler::rate_jacobians`]): the matrix's rate columns take them.
+    rates_held: bool,
     /// The converged state at the current time.
     cur: State,
     /// The iterate of the step being solved.
@@ -256,6 +259,7 @@ impl<'s> Integrator<'s> {
             rigid: (0..nodes).all(|k| sys.is_frame(k)),
             smooth: false,
             exact_rates: false,
+            rates_held: false,
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
             rhs: vec![0.0; n],

@@ -290,8 +290,14 @@ impl Integrator<'_> {
                     );
                 }
             }
-            self.asm
-                .add_rate_columns(self.sys, &self.trial, aug, 1.0, &self.rate_maps, !all);
+            // A tracked step's matrix is made at the state whose `M` and `C` the step's
+            // tangent has just evaluated (`Integrator::propagate`).
+            if self.rates_held {
+                let maps = &self.rate_maps;
+                (self.asm).add_kept_rate_columns(self.sys, &self.trial, aug, maps, !all);
+            } else {
+                (self.asm).add_rate_columns(self.sys, &self.trial, aug, 1.0, &self.rate_maps, !all);
+            }
         }
         self.transform.apply(
             &self.asm.pattern,

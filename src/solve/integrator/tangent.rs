@@ -479,9 +479,12 @@ impl Integrator<'_> {
         // not needed: the matrix reads the state and the nodes' rotations alone).
         self.trial.assign(&self.cur);
         self.block_matrices();
-        self.exact_rates = true;
+        // The elements with inertia through their derivatives, assembled once a step: the
+        // matrix's rate columns take them too.
+        self.asm.rate_jacobians(self.sys, &self.cur, aug);
+        (self.exact_rates, self.rates_held) = (true, true);
         let factored = self.refactor(h, aug, false);
-        self.exact_rates = false;
+        (self.exact_rates, self.rates_held) = (false, false);
         factored?;
         tk.h = h;
         if tk.count == 0 {
@@ -494,8 +497,6 @@ impl Integrator<'_> {
         tk.gradients.iter_mut().for_each(|x| *x = 0.0);
         // The perturbed states below differ from the end's (`trial`, which the matrix only
         // read) in their rates alone.
-        // The elements with inertia through their derivatives, assembled once a step.
-        self.asm.rate_jacobians(self.sys, &self.cur, aug);
         for c in 0..tk.count {
             tk.dir.copy_from_slice(&tk.columns[c * dim..(c + 1) * dim]);
             let moved = &mut tk.columns[c * dim..(c + 1) * dim];
