@@ -479,10 +479,13 @@ impl Integrator<'_> {
         // not needed: the matrix reads the state and the nodes' rotations alone).
         self.trial.assign(&self.cur);
         self.block_matrices();
-        // The elements with inertia through their derivatives, assembled once a step: the
-        // matrix's rate columns take them too.
-        self.asm.rate_jacobians(self.sys, &self.cur, aug);
-        (self.exact_rates, self.rates_held) = (true, true);
+        // The elements with inertia through their derivatives, assembled once a step for the
+        // carried directions: the matrix's rate columns take them too.
+        let held = tk.count > 0;
+        if held {
+            self.asm.rate_jacobians(self.sys, &self.cur, aug);
+        }
+        (self.exact_rates, self.rates_held) = (true, held);
         let factored = self.refactor(h, aug, false);
         (self.exact_rates, self.rates_held) = (false, false);
         factored?;
