@@ -194,20 +194,22 @@ fn exact_frame_columns_take_two_iterations_a_step_in_smooth_motion() {
         factored,
         1.02,
     );
-    // P3 at its step, 0.05 s, 50 s: measured 3.73 iterations a step (those of the attempts
-    // that converged), 3.20 factorizations a step, no halving, with the predictor chosen by the
-    // last step (`Predictor`); the acceleration predictor alone took 4.32, 3.97 and 3
-    // halvings, and the columns before 10.74, 10.83 and 8.
+    // P3 at its step, 0.05 s, 50 s: measured 3.457 iterations a step (those of the attempts
+    // that converged), 3.194 factorizations a step, no halving, with the predictor chosen by the
+    // last step (`Predictor`) and a new matrix's correction ending the step when the
+    // contraction's order measured over three leaves less than 1e-12 (3.73 iterations without
+    // it); the acceleration predictor alone took 4.32, 3.97 and 3 halvings, and the columns
+    // before 10.74, 10.83 and 8.
     let p3 = two_bar_stats(&[], 0.05, 50.0);
     let per_step = p3.newton_iterations as f64 / p3.steps as f64;
     let factored = p3.factorizations as f64 / p3.steps as f64;
     eprintln!("P3: {per_step:.3} iterations, {factored:.3} factorizations a step");
-    within("iterations a step, P3 at 0.05 s", per_step, 3.9);
+    within("iterations a step, P3 at 0.05 s", per_step, 3.5);
     within("factorizations a step, P3 at 0.05 s", factored, 3.5);
     assert_eq!(p3.halvings, 0, "halvings, P3 at 0.05 s");
     // The motion after the load reversal is chaotic at this step: the steps next to it take
-    // other paths. Measured 3.79, 3.77 and 3.70 iterations a step at 0.0498, 0.0499 and
-    // 0.0501 s, none halved (4.17 to 3.91 with 2, 11 and 1 halvings before); 0.0497 and
+    // other paths. Measured 3.452, 3.465 and 3.413 iterations a step at 0.0498, 0.0499 and
+    // 0.0501 s (3.79, 3.77 and 3.70 without the order's test), none halved (4.17 to 3.91 with 2, 11 and 1 halvings before); 0.0497 and
     // 0.0502 s halve 5 and 7 times (3 and 5 before).
     for dt in [0.0498, 0.0499, 0.0501] {
         let near = two_bar_stats(&[], dt, 50.0);
@@ -216,7 +218,7 @@ fn exact_frame_columns_take_two_iterations_a_step_in_smooth_motion() {
             "P3 at {dt} s: {per_step:.3} iterations a step, {} halvings",
             near.halvings
         );
-        within(&format!("iterations a step, P3 at {dt} s"), per_step, 3.9);
+        within(&format!("iterations a step, P3 at {dt} s"), per_step, 3.5);
         within(
             &format!("halvings, P3 at {dt} s"),
             near.halvings as f64,

@@ -14,6 +14,10 @@ pub(super) struct Newton {
     increment_ok: bool,
     last_increment: f64,
     previous_increment: f64,
+    /// The increment before `previous_increment`, and how many corrections in a row, ending
+    /// with the last, new matrices made.
+    before_increment: f64,
+    fresh_run: usize,
     last: f64,
     growth: usize,
     /// Whether the last correction came from a matrix made at its iterate.
@@ -33,7 +37,8 @@ pub(super) struct Newton {
 /// iterate by about this much, relative, and contracts the next correction about as far
 /// (factorizations and iterations a step: the two-bar at 1 ms over 50 s 1.08 and 2.02, 1.16
 /// and 2.02 with 1e-6, 2.02 and 2.02 without; the spin-up windmill 1.02 and 2.01, 1.54 and
-/// 2.00 with 1e-6; P3 at 0.05 s 3.20 and 3.74, 3.36 and 3.73 with 1e-6). Beam models keep it
+/// 2.00 with 1e-6; P3 at 0.05 s 3.20 and 3.74, 3.36 and 3.73 with 1e-6, before the test of
+/// the contraction's order, [`Newton::order`]). Beam models keep it
 /// only while their steps converge in two iterations (`Integrator::smooth`).
 const WITHIN: f64 = 1e-5;
 
@@ -44,14 +49,24 @@ const TAIL: f64 = 1e-2;
 
 impl Newton {
     pub(super) fn new(set: &Settings, sys: &System) -> Newton {
+        let length = sys.length_scale;
+        let tolerances = [set.increment_tolerance, set.residual_tolerance];
+        Newton::with(tolerances, length, sys.mean_mass() * length)
+    }
+
+    /// The bookkeeping of a step before its first correction, at increment and residual
+    /// tolerances, the length scale and the residual's force floor.
+    fn with([atol, rtol]: [f64; 2], length: f64, floor: f64) -> Newton {
         Newton {
-            ltol: set.increment_tolerance * sys.length_scale,
-            atol: set.increment_tolerance,
-            floor: sys.mean_mass() * sys.length_scale,
-            rtol: set.residual_tolerance,
+            ltol: atol * length,
+            atol,
+            floor,
+            rtol,
             increment_ok: false,
             last_increment: f64::NAN,
             previous_increment: f64::NAN,
+            before_increment: f64::NAN,
+            fresh_run: 0,
             last: f64::INFINITY,
             growth: 0,
             fresh: true,
@@ -89,11 +104,25 @@ impl Newton {
         let settled = rnorm <= self.rtol * scale || noise || stalled;
         // The contraction measured over the last two corrections bounds what is left: a
         // correction above the tolerance may end the step when its tail is below TAIL of it.
+        // Over three new matrices' corrections the contraction's order shows too (THEORY §7.3).
         let theta = self.last_increment / self.previous_increment;
         let contracted = theta < 1.0
-            && self.last_increment * theta / (1.0 - theta) <= TAIL * self.atol
+            && self.last_increment * theta.powf(self.order(theta)) / (1.0 - theta)
+                <= TAIL * self.atol
             && rnorm <= self.rtol * scale;
         (small && settled) || (contracted && cnorm <= self.ltol)
+    }
+
+    /// The order p of the contraction over the last three corrections when new matrices made
+    /// them all: the last contraction theta is about the one before to the power p, so what is
+    /// left after the last correction is about `d theta^p` (Newton's quadratic contraction
+    /// p = 2, a linear one p = 1). Clamped to [1, 2], and 1 (linear) unless measured.
+    fn order(&self, theta: f64) -> f64 {
+        let before = self.previous_increment / self.before_increment;
+        if self.fresh_run < 3 || !(before > 0.0 && before < 1.0 && theta > 0.0) {
+            return 1.0;
+        }
+        (theta.ln() / before.ln()).clamp(1.0, 2.0)
     }
 
     /// Whether the last correction came from a new matrix and was small enough that the same
@@ -146,7 +175,9 @@ impl Newton {
     /// matrix was made at its iterate.
     pub(super) fn record(&mut self, dmax: f64, fresh: bool) {
         self.fresh = fresh;
+        self.fresh_run = if fresh { self.fresh_run + 1 } else { 0 };
         self.increment_ok = dmax <= self.atol;
+        self.before_increment = self.previous_increment;
         self.previous_increment = self.last_increment;
         self.last_increment = dmax;
     }
@@ -236,5 +267,42 @@ impl Reuse {
         } else {
             self.next_backoff = 1;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Newton;
+
+    /// Bookkeeping at a tolerance of 1e-10 after new matrices' corrections of these sizes.
+    fn after(increments: &[f64]) -> Newton {
+        let mut newton = Newton::with([1e-10, 1e-8], 1.0, 1.0);
+        for &d in increments {
+            newton.record(d, true);
+        }
+        newton
+    }
+
+    /// The last two corrections, 1e-3 then 1e-7, leave 1e-11 by a linear contraction (above
+    /// TAIL of the tolerance, 1e-12) and 1e-15 by a quadratic one: the correction before them
+    /// tells which.
+    #[test]
+    fn the_contraction_order_decides_what_the_last_correction_leaves() {
+        let quadratic = after(&[1e-1, 1e-3, 1e-7]);
+        assert!((quadratic.order(1e-4) - 2.0).abs() < 1e-12);
+        assert!(quadratic.converged(1e-12, 1.0, 0.0));
+        // Contracting by 1e-4 twice is linear: what is left is 1e-11.
+        let linear = after(&[10.0, 1e-3, 1e-7]);
+        assert!((linear.order(1e-4) - 1.0).abs() < 1e-12);
+        assert!(!linear.converged(1e-12, 1.0, 0.0));
+        // Two corrections do not measure the order.
+        let two = after(&[1e-3, 1e-7]);
+        assert_eq!(two.order(1e-4), 1.0);
+        assert!(!two.converged(1e-12, 1.0, 0.0));
+        // A kept matrix's correction in the three breaks the measurement.
+        let mut kept = after(&[1e-1, 1e-3]);
+        kept.record(1e-7, false);
+        kept.record(1e-9, true);
+        assert_eq!(kept.order(1e-2), 1.0);
     }
 }
