@@ -16,6 +16,7 @@ mod bodies;
 mod elements;
 mod forces;
 pub mod joints;
+pub mod precise;
 mod probes;
 pub mod rotation;
 pub mod scene;
@@ -295,6 +296,11 @@ pub struct State {
     /// now (bit `k`: row `k`), chosen again as the mechanism moves.
     #[serde(default)]
     pub dropped: Vec<u16>,
+    /// What rounding left out of `q` (the exact value is `q + carry`): kept by the integrator
+    /// for the revolute angles, which grow by whole turns while each step moves them by a
+    /// little (ARCHITECTURE.md, "No round-off the step amplifies"); zero elsewhere.
+    #[serde(default)]
+    pub carry: Vec<f64>,
 }
 
 /// A rotating node's body-frame twist `(R^T x-dot, R^T omega)`, its rate and the integrator's
@@ -318,6 +324,7 @@ impl State {
             rot: vec![NodeRotation::REST; nodes],
             frames: vec![Frame::default(); nodes],
             dropped: Vec::new(),
+            carry: vec![0.0; n],
         }
     }
 
@@ -336,6 +343,16 @@ impl State {
         self.rot.copy_from_slice(&other.rot);
         self.frames.copy_from_slice(&other.frames);
         self.dropped.copy_from_slice(&other.dropped);
+        self.carry.clear();
+        self.carry.extend_from_slice(&other.carry);
+        self.carry.resize(self.q.len(), 0.0);
+    }
+
+    /// Revolute angle `i` reduced by whole turns into `[-pi, pi]`, with what rounding left out
+    /// of `q`: accurate to `1e-16` rad however many turns the angle has made.
+    #[inline]
+    pub fn phase(&self, i: usize) -> f64 {
+        precise::reduce_angle(self.q[i]) + self.carry.get(i).copied().unwrap_or(0.0)
     }
 
     /// The first unknown holding a non-finite value, if any.

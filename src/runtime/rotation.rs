@@ -18,6 +18,7 @@
 //! dynamic analysis", JAHS 38(2), 1993, Eqs. (1)-(6); O. A. Bauchau and L. Trainelli, "The
 //! vectorial parameterization of rotation", Nonlinear Dynamics 32, 2003.
 
+use super::precise::{cot_gap_coefficient, sine_gap_coefficient, versine_coefficient};
 use nalgebra::{Matrix3, Vector3};
 
 /// A 3-vector of `f64`.
@@ -249,12 +250,7 @@ pub fn orthonormalize(r: &M3) -> M3 {
 pub fn left_jacobian(theta: &V3) -> M3 {
     let t = theta.norm();
     let tt = tilde(theta);
-    let (a, b) = if t < 1e-4 {
-        (0.5 - t * t / 24.0, 1.0 / 6.0 - t * t / 120.0)
-    } else {
-        ((1.0 - t.cos()) / (t * t), (t - t.sin()) / (t * t * t))
-    };
-    M3::identity() + tt * a + tt * tt * b
+    M3::identity() + tt * versine_coefficient(t) + tt * tt * sine_gap_coefficient(t)
 }
 
 /// Inverse of [`left_jacobian`].
@@ -262,12 +258,7 @@ pub fn left_jacobian(theta: &V3) -> M3 {
 pub fn left_jacobian_inverse(theta: &V3) -> M3 {
     let t = theta.norm();
     let tt = tilde(theta);
-    let coef = if t < 1e-4 {
-        1.0 / 12.0 + t * t / 720.0
-    } else {
-        1.0 / (t * t) - (1.0 + t.cos()) / (2.0 * t * t.sin())
-    };
-    M3::identity() - tt * 0.5 + tt * tt * coef
+    M3::identity() - tt * 0.5 + tt * tt * cot_gap_coefficient(t)
 }
 
 #[cfg(test)]

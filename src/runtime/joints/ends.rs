@@ -358,6 +358,8 @@ pub(crate) struct Geo {
     pub a: EndKin,
     pub b: EndKin,
     pub phi: f64,
+    /// `phi` reduced by whole turns, to round-off of the reduced angle ([`State::phase`]).
+    pub phase: f64,
     /// Generalized velocities `(v_A, w_A, v_B, w_B, phi-dot)`.
     pub vel: Grad,
 }
@@ -370,15 +372,17 @@ impl Geo {
         vel[TA..TA + 3].copy_from_slice(ka.w.as_slice());
         vel[UB..UB + 3].copy_from_slice(kb.v.as_slice());
         vel[TB..TB + 3].copy_from_slice(kb.w.as_slice());
-        let mut phi = 0.0;
+        let (mut phi, mut phase) = (0.0, 0.0);
         if let Some(i) = angle {
             phi = st.q[i];
+            phase = st.phase(i);
             vel[PHI] = st.v[i];
         }
         Geo {
             a: ka,
             b: kb,
             phi,
+            phase,
             vel,
         }
     }

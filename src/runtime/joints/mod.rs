@@ -12,7 +12,6 @@ use super::rotation::{tilde, M3, V3};
 use super::timefn::TimeFn;
 use super::{Augment, Rate, Residual, State, TangentCoeffs};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::PI;
 
 /// Slots of the 13-component generalized vectors of a joint.
 const UA: usize = 0;
@@ -105,7 +104,7 @@ impl Row {
                 put(&mut gr, TA, &an.g);
                 put(&mut gr, TB, &-an.g);
                 gr[PHI] = -1.0;
-                wrap(an.phi_m - g.phi)
+                wrap(an.phi_m - g.phase)
             }
             Row::Phi | Row::AngleDrive { .. } | Row::AngleRate { .. } => {
                 gr[PHI] = 1.0;
@@ -291,14 +290,9 @@ impl AngleGeo {
     }
 }
 
-/// Wraps an angle into `(-pi, pi]`.
+/// Wraps an angle into `[-pi, pi]` ([`crate::runtime::precise::reduce_angle`]).
 fn wrap(x: f64) -> f64 {
-    let y = x - 2.0 * PI * ((x + PI) / (2.0 * PI)).floor();
-    if y <= -PI {
-        y + 2.0 * PI
-    } else {
-        y
-    }
+    super::precise::reduce_angle(x)
 }
 
 #[inline]

@@ -116,6 +116,10 @@ pub struct Integrator<'s> {
     mats: Vec<M3>,
     /// Unknowns moved by the SE(3) node updates instead of Newmark on coordinates.
     in_frame: Vec<bool>,
+    /// The revolute angles (flags, and the list): the rounding of `q_n + step` is kept in
+    /// `State::carry` ([`newmark::advance`]).
+    is_angle: Vec<bool>,
+    angles: Vec<usize>,
     /// The unknowns that are not multipliers, and those of them not in a frame (the flat
     /// slots of the step's tangent, `tangent::flat`): listed once for its loops.
     coords: (Vec<usize>, Vec<usize>),
@@ -225,6 +229,9 @@ impl<'s> Integrator<'s> {
         let coords: Vec<usize> = (0..n)
             .filter(|&i| !sys.unknowns[i].is_multiplier())
             .collect();
+        let angles = sys.angle_unknowns();
+        let mut is_angle = vec![false; n];
+        angles.iter().for_each(|&a| is_angle[a] = true);
         let flat = coords.iter().copied().filter(|&i| !in_frame[i]).collect();
         let mut it = Integrator {
             sys,
@@ -249,6 +256,8 @@ impl<'s> Integrator<'s> {
             blocks,
             block_node,
             in_frame,
+            is_angle,
+            angles,
             coords: (coords, flat),
             step_q: vec![0.0; n],
             step_frames: vec![[0.0; 6]; nodes],
@@ -274,6 +283,9 @@ impl<'s> Integrator<'s> {
             start: StartMetric::default(),
             tracked: None,
         };
+        for st in [&mut it.cur, &mut it.trial] {
+            st.carry.resize(n, 0.0);
+        }
         it.aug = it.scaling(set.dt);
         Ok(it)
     }
