@@ -11,6 +11,7 @@
 //! Nodes that are not frames (`System::is_frame`, beam nodes) keep only the rotational half:
 //! `R <- R exp(dtheta*)` with Newmark on `R^T omega`, their translations being coordinates.
 
+use crate::runtime::precise::coupling_coefficients;
 use crate::runtime::rotation::{exp, left_jacobian, left_jacobian_inverse, tilde, M3, V3};
 use crate::runtime::{State, System};
 
@@ -125,25 +126,11 @@ fn compose_frames(d0: &[f64; 6], d: &[f64; 6]) -> [f64; 6] {
 
 /// The translation-rotation block `Q(u, theta)` of SE(3)'s left Jacobian
 /// `[[J_l(theta), Q], [0, J_l(theta)]]` (Barfoot, *State Estimation for Robotics*, 2017,
-/// eq. 7.86), with its series below 1e-2 rad.
+/// eq. 7.86), its coefficients by series below 1 rad ([`coupling_coefficients`]).
 fn coupling(u: &V3, th: &V3) -> M3 {
     let t = th.norm();
     let (ut, tt) = (tilde(u), tilde(th));
-    let (a, b, c) = if t < 1e-2 {
-        let t2 = t * t;
-        (
-            1.0 / 6.0 - t2 / 120.0 + t2 * t2 / 5040.0,
-            1.0 / 24.0 - t2 / 720.0 + t2 * t2 / 40320.0,
-            1.0 / 120.0 - t2 / 2520.0 + t2 * t2 / 120960.0,
-        )
-    } else {
-        let (s, co) = t.sin_cos();
-        (
-            (t - s) / t.powi(3),
-            (t * t + 2.0 * co - 2.0) / (2.0 * t.powi(4)),
-            (2.0 * t - 3.0 * s + t * co) / (2.0 * t.powi(5)),
-        )
-    };
+    let (a, b, c) = coupling_coefficients(t);
     let (tu, ttu) = (tt * ut, tt * tt * ut);
     let tut = tu * tt;
     ut * 0.5
