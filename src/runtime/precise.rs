@@ -123,17 +123,17 @@ pub(crate) fn coupling_coefficients(t: f64) -> (f64, f64, f64) {
         1.0 / 5676771352412160000.0,
         -1.0 / 2585201673888497664000.0,
     ];
-    if t < 1.0 {
+    let (b, c) = if t < 1.0 {
         let t2 = t * t;
-        (sine_gap_coefficient(t), horner(&B, t2), horner(&C, t2))
+        (horner(&B, t2), horner(&C, t2))
     } else {
         let (s, co) = t.sin_cos();
         (
-            (t - s) / t.powi(3),
             (t * t + 2.0 * co - 2.0) / (2.0 * t.powi(4)),
             (2.0 * t - 3.0 * s + t * co) / (2.0 * t.powi(5)),
         )
-    }
+    };
+    (sine_gap_coefficient(t), b, c)
 }
 
 #[cfg(test)]
