@@ -112,6 +112,20 @@ pub struct Floquet {
     pub how: Monodromy,
     /// Partial Floquet's account ([`Monodromy::Krylov`]; `monodromy` is empty then).
     pub partial: Option<Partial>,
+    /// The multipliers left out as round-off of the monodromy, if any ([`Unresolved`]).
+    pub unresolved: Option<Unresolved>,
+}
+
+/// Multipliers at the monodromy's round-off: their exponents are not resolved, and are not
+/// listed (they are known only to lie below `real_below`).
+#[derive(Clone, Debug)]
+pub struct Unresolved {
+    /// How many.
+    pub count: usize,
+    /// The modulus they do not exceed.
+    pub modulus: f64,
+    /// The real part (1/s) their exponents lie below: `ln(modulus) / T`.
+    pub real_below: f64,
 }
 
 /// What partial Floquet did: the multipliers wanted, the block's size, the runs of a period
@@ -291,7 +305,7 @@ pub fn floquet_by(
         ),
         None => (phi.clone(), n, &history, z0),
     };
-    let modes = eigen(&matrix, r).ok_or_else(|| {
+    let (modes, unresolved) = resolved_modes(&matrix, r, period).ok_or_else(|| {
         reference_failure(RuntimeFailure {
             kind: super::FailureKind::Singular,
             t: period,
@@ -341,7 +355,39 @@ pub fn floquet_by(
         settling,
         how,
         partial: None,
+        unresolved,
     })
+}
+
+/// Multipliers with their eigenvectors.
+type Modes = Vec<(c64, Vec<(f64, f64)>)>;
+
+/// The eigenpairs of `matrix` (`r x r`, largest multiplier first) whose multipliers exceed its
+/// round-off ([`RESOLVED`]), and those left out, if any.
+fn resolved_modes(matrix: &[f64], r: usize, period: f64) -> Option<(Modes, Option<Unresolved>)> {
+    let mut modes = eigen(matrix, r)?;
+    let floor = resolution(matrix);
+    let count = modes.len();
+    modes.retain(|(m, _)| m.re.hypot(m.im) > floor);
+    let unresolved = (modes.len() < count).then_some(Unresolved {
+        count: count - modes.len(),
+        modulus: floor,
+        real_below: floor.ln() / period,
+    });
+    Some((modes, unresolved))
+}
+
+/// Round-offs of the monodromy (`f64::EPSILON` times its Frobenius norm) a multiplier's
+/// modulus must exceed to be resolved: its own round-off is then at most 1e-3 of it, and its
+/// exponent's real part known to `1e-3 / T`. The elastic windmill at Omega_bar 1.5 (settled
+/// projection of norm 124, T = 0.45 s): its multipliers near 1e-9 (Re s = -45.6 1/s) move by
+/// 1e-15 of their own when the speed moves by 1e-13; those near 2e-15 (Re s = -75 1/s and
+/// below) move by up to 6 1/s, and are round-off.
+const RESOLVED: f64 = 1e3;
+
+/// The modulus at or below which a multiplier of `matrix` is round-off ([`RESOLVED`]).
+fn resolution(matrix: &[f64]) -> f64 {
+    RESOLVED * f64::EPSILON * matrix.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// How the monodromy is built for a state of `dim` entries: from runs where the integrator

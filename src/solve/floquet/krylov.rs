@@ -323,6 +323,8 @@ pub(super) fn partial(
             products: k.products,
             converged: k.converged,
         }),
+        // The Ritz values of largest modulus only: none at round-off.
+        unresolved: None,
     })
 }
 

@@ -215,11 +215,15 @@ fn summary(spec: &SweepSpec, point: &Point) -> String {
             method.name(),
             point.max_real(),
             point.cpu_s,
-            // Partial Floquet says what it did.
-            point
-                .detail
-                .split_once("; partial: ")
-                .map_or(String::new(), |(_, p)| format!(" (partial: {p})"))
+            // Partial Floquet says what it did; multipliers at round-off, how many.
+            ["; partial: ", "; at round-off: "]
+                .iter()
+                .filter_map(|key| point.detail.split_once(key).map(|(_, p)| (key, p)))
+                .map(|(key, p)| {
+                    let p = p.split("; ").next().unwrap_or(p);
+                    format!(" ({}{p})", &key[2..])
+                })
+                .collect::<String>()
         ),
     }
 }
@@ -304,8 +308,13 @@ fn floquet_point(spec: &SweepSpec, c: &Compiled) -> Result<Found, PointError> {
                 } else {
                     " (not converged before the basis spanned the state)"
                 }
-            ))
-        ),
+            )),
+        ) + &f.unresolved.as_ref().map_or(String::new(), |u| {
+            format!(
+                "; at round-off: {} multipliers of modulus below {:.1e}, Re s < {:.4} 1/s, not listed",
+                u.count, u.modulus, u.real_below
+            )
+        }),
     })
 }
 
