@@ -8,6 +8,7 @@ pub mod charts;
 pub mod gltf;
 mod guides;
 mod legend;
+mod number;
 pub mod raster;
 pub mod ticks;
 pub mod view;
@@ -17,14 +18,16 @@ use std::io::{self, Write};
 
 pub struct CsvWriter<W: Write> {
     out: io::BufWriter<W>,
-    line: String,
+    line: Vec<u8>,
+    digits: zmij::Buffer,
 }
 
 impl<W: Write> CsvWriter<W> {
     pub fn new(out: W, sys: &System) -> io::Result<CsvWriter<W>> {
         let mut w = CsvWriter {
             out: io::BufWriter::new(out),
-            line: String::new(),
+            line: Vec::new(),
+            digits: zmij::Buffer::new(),
         };
         let mut header = String::from("t");
         for c in &sys.channels {
@@ -36,16 +39,17 @@ impl<W: Write> CsvWriter<W> {
     }
 
     pub fn row(&mut self, sys: &System, st: &State, aug: Augment) -> io::Result<()> {
-        use std::fmt::Write as _;
         self.line.clear();
-        // `{:?}` prints the shortest text that reads back to the same f64.
-        // `+ 0.0` turns a negative zero into zero.
-        let _ = write!(self.line, "{:?}", st.t + 0.0);
+        // The shortest text that reads back to the same f64, as `{:?}` writes it
+        // (`number.rs`). `+ 0.0` turns a negative zero into zero.
+        number::push(&mut self.line, &mut self.digits, st.t + 0.0);
         for c in &sys.channels {
-            let _ = write!(self.line, ",{:?}", sys.probe(&c.probe, st, aug) + 0.0);
+            self.line.push(b',');
+            let x = sys.probe(&c.probe, st, aug) + 0.0;
+            number::push(&mut self.line, &mut self.digits, x);
         }
-        self.line.push('\n');
-        self.out.write_all(self.line.as_bytes())
+        self.line.push(b'\n');
+        self.out.write_all(&self.line)
     }
 
     pub fn flush(&mut self) -> io::Result<()> {
