@@ -355,6 +355,9 @@ fn exponents_at_the_round_off_of_the_monodromy_are_left_out() {
         178,
         "the settled projection's size"
     );
+    assert_eq!(ua.count, 96);
+    // The bound, ln(1e3 eps 124) / 0.4524 s.
+    assert!((ua.real_below + 53.76).abs() < 0.05, "{}", ua.real_below);
     // What is listed lies above the bound, and the bound between the resolved cluster at
     // -45.6 1/s and the round-off from -75 1/s.
     assert!(a.exponents.iter().all(|s| s.re > ua.real_below));
