@@ -94,7 +94,7 @@ pub struct Settings {
     /// How many times a failing step is halved before the run fails: [`HALVINGS`] = 3, and
     /// [`STATIC_HALVINGS`] = 4 for statics (not settable).
     pub max_halvings: usize,
-    /// How the iteration matrix is kept. Default auto.
+    /// How the iteration matrix is kept. Default full ([`NewtonMode::Full`]).
     pub newton: NewtonMode,
 }
 
@@ -115,7 +115,7 @@ impl Default for Settings {
             residual_tolerance: RESIDUAL_TOLERANCE,
             max_iterations: MAX_ITERATIONS_DEFAULT,
             max_halvings: HALVINGS,
-            newton: NewtonMode::Auto,
+            newton: NewtonMode::Full,
         }
     }
 }

@@ -65,7 +65,7 @@ impl PivotFree {
                 y[f + j] -= s;
             }
             for k in (0..w).rev() {
-                y[f + k] /= l[k + k * ld];
+                y[f + k] *= self.recip[f + k];
                 let yk = y[f + k];
                 for i in 0..k {
                     y[f + i] -= l[i + k * ld] * yk;
@@ -173,9 +173,9 @@ impl PivotFree {
                 }
             }
             for k in (0..w).rev() {
-                let d = l[k + k * ld];
+                let d = self.recip[f + k];
                 for c in 0..B {
-                    y[f + k][c] /= d;
+                    y[f + k][c] *= d;
                 }
                 let yk = y[f + k];
                 for (yi, &lik) in y[f..f + k].iter_mut().zip(&l[k * ld..k * ld + k]) {
