@@ -11,7 +11,10 @@
 //! Contract: reads a pattern, its elimination and values; must not know elements or the
 //! integrator.
 
+mod dense;
 mod substitute;
+
+use dense::{Dense, DENSE_MAX};
 
 use super::ordering::{Elimination, Rule};
 use crate::runtime::Pattern;
@@ -82,6 +85,8 @@ pub struct PivotFree {
     factorizations: usize,
     checked: bool,
     refining: bool,
+    /// The whole system as one dense block, for small systems ([`DENSE_MAX`]).
+    dense: Option<Dense>,
 }
 
 /// The new column whose pivot was tiny, as its original unknown.
@@ -143,9 +148,7 @@ impl PivotFree {
             }
         }
         let mut covered = vec![false; size];
-        for &d in &dest {
-            covered[d] = true;
-        }
+        dest.iter().for_each(|&d| covered[d] = true);
         let fill = (0..size).filter(|&d| !covered[d]).collect();
         let (mut updates, mut updates_ptr, mut pos) = (Vec::new(), vec![0], Vec::new());
         let mut tmp_len = 0;
@@ -173,6 +176,7 @@ impl PivotFree {
             }
             updates_ptr.push(updates.len());
         }
+        let dense = (n <= DENSE_MAX).then(|| Dense::new(pattern, &inv));
         PivotFree {
             perm: e.perm.clone(),
             first: e.first.clone(),
@@ -207,7 +211,16 @@ impl PivotFree {
             factorizations: 0,
             checked: false,
             refining: true,
+            dense,
         }
+    }
+
+    /// As [`PivotFree::new`], supernodal at every size (the tests compare both paths).
+    #[cfg(test)]
+    fn supernodal(pattern: &Pattern, late: &[bool], rule: Rule) -> PivotFree {
+        let mut lu = PivotFree::new(pattern, late, rule);
+        lu.dense = None;
+        lu
     }
 
     /// Factors the matrix with the analysed pattern and `values`.
@@ -216,6 +229,16 @@ impl PivotFree {
         self.factorizations = self.factorizations.wrapping_add(1);
         if self.checked {
             self.a.copy_from_slice(values);
+        }
+        if let Some(dense) = &mut self.dense {
+            for (j, &c) in self.new_of.iter().enumerate() {
+                let column = &values[self.col_ptr[j]..self.col_ptr[j + 1]];
+                // As below: a NaN shows as a NaN pivot.
+                self.scale[c] = column
+                    .iter()
+                    .fold(0.0, |m, v| if v.abs() > m { v.abs() } else { m });
+            }
+            return dense.factor(values, &self.scale, &self.perm);
         }
         for &d in &self.fill {
             self.x[d] = 0.0;
@@ -403,6 +426,9 @@ impl PivotFree {
             let m = self.rows_ptr[t + 1] - self.rows_ptr[t];
             *widths.entry(w).or_insert(0) += 1;
             flops += w * w * w / 3 + w * w * m * 2 + w * m * m * 2;
+        }
+        if self.dense.is_some() {
+            return format!("{} unknowns, dense", self.perm.len());
         }
         format!(
             "{} unknowns, {ns} supernodes (width: count {widths:?}), {} values stored, {flops} multiply-adds",

@@ -80,6 +80,9 @@ pub enum Stop<E> {
 
 pub struct Integrator<'s> {
     sys: &'s System,
+    /// The system's mean translational mass and mean stiffness, for the scaling and the
+    /// residual's force floor (made once: each is a pass over the elements).
+    means: (f64, f64),
     set: Settings,
     sc: Scheme,
     /// The method (the settings'), and how rotations are held.
@@ -235,6 +238,7 @@ impl<'s> Integrator<'s> {
         let flat = coords.iter().copied().filter(|&i| !in_frame[i]).collect();
         let mut it = Integrator {
             sys,
+            means: (sys.mean_mass(), sys.mean_stiffness()),
             set: set.clone(),
             sc: Scheme::of(set),
             method: set.method,
@@ -326,11 +330,12 @@ impl<'s> Integrator<'s> {
 
     /// `s = p = m/(beta h^2) + k` (THEORY §6); rate rows scaled by `beta h / gamma`.
     fn scaling(&self, h: f64) -> Augment {
-        let inertia = self.sys.mean_mass() / (self.sc.beta * h * h);
-        let k = if self.method == Method::Static && self.sys.mean_stiffness() > 0.0 {
-            self.sys.mean_stiffness()
+        let (mass, stiffness) = self.means;
+        let inertia = mass / (self.sc.beta * h * h);
+        let k = if self.method == Method::Static && stiffness > 0.0 {
+            stiffness
         } else {
-            inertia + self.sys.mean_stiffness()
+            inertia + stiffness
         };
         Augment {
             s: k,

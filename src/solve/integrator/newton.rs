@@ -48,10 +48,12 @@ const WITHIN: f64 = 1e-5;
 const TAIL: f64 = 1e-2;
 
 impl Newton {
-    pub(super) fn new(set: &Settings, sys: &System) -> Newton {
+    /// The bookkeeping of a step of `sys` under `set`, whose mean translational mass is
+    /// `mean_mass` ([`System::mean_mass`]).
+    pub(super) fn new(set: &Settings, sys: &System, mean_mass: f64) -> Newton {
         let length = sys.length_scale;
         let tolerances = [set.increment_tolerance, set.residual_tolerance];
-        Newton::with(tolerances, length, sys.mean_mass() * length)
+        Newton::with(tolerances, length, mean_mass * length)
     }
 
     /// The bookkeeping of a step before its first correction, at increment and residual

@@ -114,7 +114,7 @@ impl Integrator<'_> {
         } else {
             self.newmark_predict(h, rescale, keep_rate > 0.0, predictor);
         }
-        let mut newton = Newton::new(&self.set, self.sys);
+        let mut newton = Newton::new(&self.set, self.sys, self.means.0);
         newton.as_new = self.reuse.mode() == NewtonMode::Full;
         let max = self.set.max_iterations;
         // Whether the last correction came from a kept matrix, and the residual's total

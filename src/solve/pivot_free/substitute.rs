@@ -17,6 +17,13 @@ impl PivotFree {
         for (k, &o) in self.perm.iter().enumerate() {
             y[k] = rhs[o];
         }
+        if let Some(dense) = &self.dense {
+            dense.substitute(y);
+            for (k, &o) in self.perm.iter().enumerate() {
+                rhs[o] = y[k];
+            }
+            return;
+        }
         let ns = self.first.len() - 1;
         // Forward: each supernode's own unknowns, then its rows below through one dense
         // product and one scatter.
@@ -83,6 +90,12 @@ impl PivotFree {
     /// call and is kept.
     pub fn substitute_many(&mut self, rhs: &mut [f64], count: usize) {
         let n = self.perm.len();
+        if self.dense.is_some() {
+            for col in rhs.chunks_exact_mut(n.max(1)).take(count) {
+                self.substitute(col);
+            }
+            return;
+        }
         // Passes of equal width, as few as [`LANES`] allows.
         let passes = count.div_ceil(LANES);
         let mut done = 0;
