@@ -164,24 +164,29 @@ impl Row {
                 }
                 let n = d / len;
                 let proj = (M3::identity() - n * n.transpose()) * (mu / len);
-                // D: d(d)/dq = [-I, p_A~, I, -p_B~].
+                // D: d(d)/dq = [-I, p_A~, I, -p_B~] over (u_A, theta_A, u_B, theta_B).
                 let (pa, pb) = (tilde(&g.a.p), tilde(&g.b.p));
-                let dcols = [
-                    (UA, -M3::identity()),
-                    (TA, pa),
-                    (UB, M3::identity()),
-                    (TB, -pb),
+                // Forces: u_A: -mu n, theta_A: -mu p_A~ n, u_B: mu n, theta_B: mu p_B~ n; each
+                // block is the force's row operator times `proj D_c`. An end without an arm (a
+                // ground, a point mass) has no rotation's blocks: their operator is zero.
+                let (arm_a, arm_b) = (g.a.p != V3::zeros(), g.b.p != V3::zeros());
+                let cols = [
+                    (UA, -proj, true),
+                    (TA, proj * pa, arm_a),
+                    (UB, proj, true),
+                    (TB, -(proj * pb), arm_b),
                 ];
-                // Forces: u_A: -mu n, theta_A: -mu p_A~ n, u_B: mu n, theta_B: mu p_B~ n.
-                let rows = [
-                    (UA, -M3::identity()),
-                    (TA, -pa),
-                    (UB, M3::identity()),
-                    (TB, pb),
-                ];
-                for (r0, lr) in rows {
-                    for (c0, dc) in dcols {
-                        block(h, r0, c0, &(lr * proj * dc));
+                for (c0, x, live) in cols {
+                    if !live {
+                        continue;
+                    }
+                    block(h, UA, c0, &-x);
+                    if arm_a {
+                        block(h, TA, c0, &(-pa * x));
+                    }
+                    block(h, UB, c0, &x);
+                    if arm_b {
+                        block(h, TB, c0, &(pb * x));
                     }
                 }
                 let nt = tilde(&n);
