@@ -4,9 +4,13 @@ For each problem, both codes run along the same ladder of time steps; every run 
 with one reference at common output times, and the CPU time each code needs to reach relative
 errors 1e-3 and 1e-6 is interpolated (log-log) along its ladder. See README.md.
 
-Usage (run.sh sets up the virtual environment):  python peers.py [--quick] [--only NAME]
+Usage (run.sh sets up the virtual environment):  python peers.py [--quick] [--only NAME] [--cli]
+mbd runs in this process through its Python package, as Exudyn does (its record's `cpu_s`:
+the run's thread CPU, start, time loop and rows); `--cli` times the `mbd run` binary instead
+(its printed solve time, in a fresh process each run).
 Environment: MBD (the mbd binary; default target/release/mbd from the repository root),
-             MBD_ARGS (integrator flags for mbd; default generalized-alpha, rho_inf 0.9),
+             MBD_ARGS (integrator flags for mbd under --cli; default generalized-alpha,
+             rho_inf 0.9, which the in-process runs use),
              PEERS_REPEAT (repeats of runs shorter than 0.2 s, the fastest kept; default 3).
 """
 
@@ -34,9 +38,16 @@ EXUDYN_IMPORT_CPU = time.process_time() - _t
 sys.path.insert(0, HERE)
 import exudyn_models  # noqa: E402
 
+try:  # the repository's Python package, which run.sh builds into the venv
+    import mbd as mbd_package  # noqa: E402
+except ImportError:
+    mbd_package = None
+
 MBD = os.environ.get("MBD", os.path.join(ROOT, "target", "release", "mbd"))
 MBD_ARGS = shlex.split(os.environ.get("MBD_ARGS", "--integrator generalized-alpha --rho-inf 0.9"))
 REPEAT = int(os.environ.get("PEERS_REPEAT", "3"))
+# How mbd is timed: "package" (in this process, as Exudyn) or "cli" (main() sets it).
+MODE = {"mbd": "package"}
 RHO_INF = 0.9
 TARGETS = (1e-3, 1e-6)
 # Two references closer than this (relative) are taken as agreeing.
@@ -92,8 +103,29 @@ def children_cpu():
 
 
 def run_mbd(p, dt):
-    """One mbd run: (values on the grid, reported solve time [s], whole-process CPU [s],
-    Newton iterations)."""
+    """One mbd run: (values on the grid, solve time [s], other CPU [s], Newton iterations).
+    In this process through the Python package: the run's thread CPU, and the compile's CPU
+    as the other; under --cli: the binary's reported solve time, and its whole process."""
+    if MODE["mbd"] == "package":
+        return run_mbd_package(p, dt)
+    return run_mbd_cli(p, dt)
+
+
+def run_mbd_package(p, dt):
+    every = int(round(p["period"] / dt))
+    t0 = time.process_time()
+    sets = dict(s.split("=", 1) for s in p["sets"])
+    model = mbd_package.compile(os.path.join(ROOT, p["model"]), set=sets or None, lint=False)
+    build = time.process_time() - t0
+    r = model.run(dt=dt, until=p["until"], integrator="generalized-alpha", every=every,
+                  rho_inf=RHO_INF)
+    if not r.ok:
+        raise Failed(f"mbd failed at t = {r.failure.t} s: {r.failure}")
+    values = on_grid(r.t, np.column_stack([r[c] for c in p["channels"]]), p)
+    return values, r.record.cpu_s, build, r.record.newton_iterations
+
+
+def run_mbd_cli(p, dt):
     every = int(round(p["period"] / dt))
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "run.csv")
@@ -268,11 +300,14 @@ def study(p, rows, quick):
                 continue
             e = rel_error(r[0], ref)
             pts[code].append((r[1], e))
-            # mbd: (csv, solve, process, newton); Exudyn: (csv, solve, build).
-            extra = (dict(process_cpu_s=r[2], build_cpu_s="", newton=r[3]) if code == "mbd"
-                     else dict(process_cpu_s="", build_cpu_s=r[2], newton=""))
+            # mbd: (csv, solve, process or compile, newton); Exudyn: (csv, solve, build).
+            cli = code == "mbd" and MODE["mbd"] == "cli"
+            extra = (dict(process_cpu_s=r[2], build_cpu_s="", newton=r[3]) if cli
+                     else dict(process_cpu_s="", build_cpu_s=r[2],
+                               newton=r[3] if code == "mbd" else ""))
             rows.append(dict(row, rel_error=e, solve_cpu_s=r[1], **extra))
-    print(f"  {'dt [s]':>11} {'mbd error':>11} {'mbd solve':>11} {'mbd proc':>10} "
+    third_m = "mbd proc" if MODE["mbd"] == "cli" else "mbd build"
+    print(f"  {'dt [s]':>11} {'mbd error':>11} {'mbd solve':>11} {third_m:>10} "
           f"{'Exu error':>11} {'Exu solve':>11} {'Exu build':>10}")
     for dt in dts:
         m = [r for r in rows if r["problem"] == p["name"] and r["dt"] == dt]
@@ -281,7 +316,7 @@ def study(p, rows, quick):
             if r["rel_error"] == "failed":
                 cells.append(f"{'failed':>11} {'':>11} {'':>10}")
             else:
-                third = r["process_cpu_s"] if r["code"] == "mbd" else r["build_cpu_s"]
+                third = r["process_cpu_s"] or r["build_cpu_s"]
                 cells.append(f"{r['rel_error']:11.3e} {r['solve_cpu_s']:11.3e} {third:10.3e}")
         print(f"  {dt:11.4e} " + " ".join(cells))
 
@@ -315,7 +350,8 @@ def chart(r):
         ax.axhline(t, color="grey", linestyle=":", linewidth=1)
     ax.axhline(r["apart"], color="tab:red", linestyle="-.", linewidth=1,
                label=f"references apart ({r['apart']:.1e})")
-    ax.set_xlabel("solve CPU time [s] (mbd: its reported solve time; Exudyn: SolveDynamic)")
+    ax.set_xlabel("solve CPU time [s] (mbd: " + ("its reported solve time" if MODE["mbd"] == "cli"
+                  else "Model.run's cpu_s") + "; Exudyn: SolveDynamic)")
     ax.set_ylabel("relative error (max over channels)")
     ax.set_title(f"{p['title']}: {', '.join(p['channels'])}\n"
                  f"reference: {r['ref_name']} at dt = {p['dts'][-1] / 4:g} s", fontsize=10)
@@ -337,15 +373,22 @@ def write(results, rows, started):
         "",
         f"Generated by `benches/peers/peers.py` on {time.strftime('%Y-%m-%d %H:%M')} "
         f"({os.cpu_count()} cores), {time.time() - started:.0f} s wall.",
-        f"mbd: `{MBD}` ({version or 'version unknown'}) with `{' '.join(MBD_ARGS)}`; "
+        (f"mbd: `{MBD}` ({version or 'version unknown'}) with `{' '.join(MBD_ARGS)}`; "
+         if MODE["mbd"] == "cli" else
+         f"mbd: its Python package ({getattr(mbd_package, '__file__', '?')}), "
+         f"generalized-alpha rho_inf {RHO_INF} (whole-process figures: `--cli`); ") +
         f"Exudyn {exu.config.Version() if hasattr(exu, 'config') else exu.__version__}, "
         f"generalized-alpha rho_inf {RHO_INF}, modified Newton, dense solver "
         "(EigenSparse on the windmill).",
         "",
-        "CPU is each code's solve time: mbd's reported solve time (the figure it prints, "
-        "wall-clock around its time loop), Exudyn's `SolveDynamic` (process CPU). "
-        f"Exudyn's import took {EXUDYN_IMPORT_CPU:.2f} s CPU once; model building and mbd's "
-        "whole-process CPU are in `ladder.csv`.",
+        "CPU is each code's solve time: " + (
+            "mbd's reported solve time (the figure `mbd run` prints, wall-clock around its "
+            "time loop, in a fresh process each run)" if MODE["mbd"] == "cli" else
+            "mbd's run in this process through its Python package (`Record.cpu_s`, the "
+            "run's thread CPU: start, time loop, rows)") +
+        ", Exudyn's `SolveDynamic` (process CPU), both the fastest of repeated runs. "
+        f"Exudyn's import took {EXUDYN_IMPORT_CPU:.2f} s CPU once; model building (mbd's "
+        "compile) and, under `--cli`, mbd's whole-process CPU are in `ladder.csv`.",
         "",
         "| problem | code | CPU to 1e-3 | CPU to 1e-6 |",
         "|---|---|---|---|",
@@ -368,12 +411,18 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="three ladder steps only (a smoke test)")
     ap.add_argument("--only", help="run one problem (pendulum, two_bar, windmill_1, windmill_2)")
+    ap.add_argument("--cli", action="store_true",
+                    help="time the mbd binary (a fresh process a run) instead of the package")
     a = ap.parse_args()
+    MODE["mbd"] = "cli" if a.cli or mbd_package is None else "package"
+    if mbd_package is None and not a.cli:
+        print("mbd's Python package is not installed here: timing the binary (--cli)")
     if not os.access(MBD, os.X_OK):
         sys.exit(f"no mbd binary at {MBD}: run `cargo build --release` or set MBD")
     os.makedirs(OUT, exist_ok=True)
     started = time.time()
-    print(f"mbd: {MBD} {' '.join(MBD_ARGS)}; Exudyn {exu.__version__} "
+    who = f"{MBD} {' '.join(MBD_ARGS)}" if MODE["mbd"] == "cli" else "Python package"
+    print(f"mbd: {who}; Exudyn {exu.__version__} "
           f"(import {EXUDYN_IMPORT_CPU:.2f} s CPU), generalized-alpha rho_inf {RHO_INF}")
     rows, results = [], []
     for p in PROBLEMS:
