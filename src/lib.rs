@@ -370,7 +370,9 @@ pub fn run_observed(
     let mut look = |st: &runtime::State, aug| {
         if let Some(observe) = observe.as_mut() {
             values.clear();
-            values.extend(sys.channels.iter().map(|ch| sys.probe(&ch.probe, st, aug)));
+            sys.probe_each(sys.channels.iter().map(|ch| &ch.probe), st, aug, |x| {
+                values.push(x)
+            });
             observe(st, &values);
         }
     };

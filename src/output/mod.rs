@@ -43,11 +43,11 @@ impl<W: Write> CsvWriter<W> {
         // The shortest text that reads back to the same f64, as `{:?}` writes it
         // (`number.rs`). `+ 0.0` turns a negative zero into zero.
         number::push(&mut self.line, &mut self.digits, st.t + 0.0);
-        for c in &sys.channels {
-            self.line.push(b',');
-            let x = sys.probe(&c.probe, st, aug) + 0.0;
-            number::push(&mut self.line, &mut self.digits, x);
-        }
+        let (line, digits) = (&mut self.line, &mut self.digits);
+        sys.probe_each(sys.channels.iter().map(|c| &c.probe), st, aug, |x| {
+            line.push(b',');
+            number::push(line, digits, x + 0.0);
+        });
         self.line.push(b'\n');
         self.out.write_all(&self.line)
     }

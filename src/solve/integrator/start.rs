@@ -121,6 +121,9 @@ impl Integrator<'_> {
         self.trial.clone_from(initial);
         self.mid.clone_from(initial);
         self.tracked = None;
+        // The multipliers' and accelerations' past are the last run's.
+        self.last_h = None;
+        self.history.clear();
         self.reuse = Reuse::new(self.set.newton, self.set.method);
         self.stats = RunStats::default();
         self.step_index = 0;

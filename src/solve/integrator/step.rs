@@ -8,17 +8,21 @@ use crate::runtime::rotation::V3;
 use crate::settings::{Method, NewtonMode};
 use crate::solve::FailureKind;
 
-/// Where a step's Newton iteration starts. A step tries first the predictor that came nearer
-/// the last step's solution (`Integrator::predictor_misses`): the acceleration unchanged in
-/// smooth motion (third order), the velocity unchanged where the accelerations alternate from
-/// step to step. On the paper's two-bar at 0.05 s the accelerations alternate after the load
-/// reversal (at 18.5 s the acceleration predictor misses the hinge by 0.16 m, the velocity
-/// predictor by 0.07 m): 3.73 Newton iterations a step and no halving, against 4.32 and 3 from
-/// the acceleration predictor alone (3.46 with [`Newton::order`]'s test).
+/// Where a step's Newton iteration starts. A step tries first the predictor that came nearest
+/// the last step's solution (`Integrator::best_predictor`): the acceleration unchanged, or
+/// continued by a polynomial through the last steps' (smooth motion; [`super::history`]), or
+/// the velocity unchanged where the accelerations alternate from step to step. On the paper's
+/// two-bar at 0.05 s the accelerations alternate after the load reversal (at 18.5 s the
+/// acceleration predictor misses the hinge by 0.16 m, the velocity predictor by 0.07 m): 3.73
+/// Newton iterations a step and no halving, against 4.32 and 3 from the acceleration
+/// predictor alone (3.46 with [`Newton::order`]'s test).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Predictor {
     /// The acceleration unchanged (statics: the last load step's equilibrium).
     Acceleration,
+    /// The algorithmic acceleration extrapolated at this order (1 to
+    /// [`super::history::ORDERS`]) from the last steps of the same size.
+    Extrapolated(usize),
     /// The velocity unchanged, for a step too long for the accelerations' changes.
     Velocity,
 }
@@ -27,7 +31,7 @@ impl Predictor {
     /// The predictor a step falls back on.
     pub(super) fn other(self) -> Predictor {
         match self {
-            Predictor::Acceleration => Predictor::Velocity,
+            Predictor::Acceleration | Predictor::Extrapolated(_) => Predictor::Velocity,
             Predictor::Velocity => Predictor::Acceleration,
         }
     }
