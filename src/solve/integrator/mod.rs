@@ -568,8 +568,11 @@ impl<'s> Integrator<'s> {
         if self.method == Method::Fet {
             self.fet_commit(h)
         } else {
-            if self.method != Method::Static {
+            // A predictor that ended the step at its first correction stays.
+            if self.method != Method::Static && it > 1 {
                 self.predictor = self.best_predictor(h);
+            }
+            if self.method != Method::Static && self.extrapolates() {
                 self.history.push(&self.cur, h, continued);
             }
             self.newmark_commit()

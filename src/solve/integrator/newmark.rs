@@ -197,7 +197,7 @@ impl Integrator<'_> {
     /// paper's step, chaotic, failed at 12.8 s from them, and with kept matrices the windmill's
     /// tracked Floquet run took 1,232 iterations over 972 steps instead of 995.
     pub(super) fn best_predictor(&self, h: f64) -> Predictor {
-        let orders = if self.rigid && self.reuse.mode() == NewtonMode::Full {
+        let orders = if self.extrapolates() {
             self.history.orders(h)
         } else {
             0
@@ -242,6 +242,11 @@ impl Integrator<'_> {
             }
         }
         all[best]
+    }
+
+    /// Whether steps may start from extrapolated accelerations (see `best_predictor`).
+    pub(super) fn extrapolates(&self) -> bool {
+        self.rigid && self.reuse.mode() == NewtonMode::Full
     }
 
     /// The residual at the iterate, in `rhs` in the treatment's unknowns, and its norms.
