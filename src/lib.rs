@@ -303,6 +303,27 @@ pub fn run_observed(
     c: &Compiled,
     out: &mut dyn Write,
     progress: &mut dyn FnMut(usize, usize),
+    observe: Option<Observer<'_>>,
+) -> Result<RunReport, RunFailure> {
+    run_rows(c, Some(out), progress, observe)
+}
+
+/// [`run_observed`] without the CSV: `observe` takes every row's values (the start included),
+/// each the `f64` the CSV writes the shortest text of (a negative zero aside). For callers
+/// that keep the values themselves (the Python package), which the text would cost more
+/// than the pendulum's steps.
+pub fn run_values(
+    c: &Compiled,
+    progress: &mut dyn FnMut(usize, usize),
+    observe: Observer<'_>,
+) -> Result<RunReport, RunFailure> {
+    run_rows(c, None, progress, Some(observe))
+}
+
+fn run_rows(
+    c: &Compiled,
+    out: Option<&mut dyn Write>,
+    progress: &mut dyn FnMut(usize, usize),
     mut observe: Option<Observer<'_>>,
 ) -> Result<RunReport, RunFailure> {
     let set = &c.settings;
@@ -330,13 +351,18 @@ pub fn run_observed(
             rows: 0,
         });
     }
-    let mut csv = output::CsvWriter::new(out, sys).map_err(|e| io_fail(e, 0))?;
+    let mut csv = match out {
+        Some(out) => Some(output::CsvWriter::new(out, sys).map_err(|e| io_fail(e, 0))?),
+        None => None,
+    };
     let mut warnings = Vec::new();
     let fail = |f: RuntimeFailure,
-                csv: &mut output::CsvWriter<&mut dyn Write>,
+                csv: &mut Option<output::CsvWriter<&mut dyn Write>>,
                 warnings: Vec<Diagnostic>,
                 rows| {
-        let _ = csv.flush();
+        if let Some(csv) = csv {
+            let _ = csv.flush();
+        }
         RunFailure {
             diagnostic: c.failure_diagnostic(&f),
             failure: Some(f),
@@ -364,8 +390,10 @@ pub fn run_observed(
         }
         Err(f) => return Err(fail(f, &mut csv, warnings, 0)),
     }
-    csv.row(sys, hht.state(), hht.augment())
-        .map_err(|e| io_fail(e, 0))?;
+    if let Some(csv) = csv.as_mut() {
+        csv.row(sys, hht.state(), hht.augment())
+            .map_err(|e| io_fail(e, 0))?;
+    }
     let mut values = Vec::with_capacity(sys.channels.len());
     let mut look = |st: &runtime::State, aug| {
         if let Some(observe) = observe.as_mut() {
@@ -381,7 +409,9 @@ pub fn run_observed(
     let ran = hht.run(|k, it| {
         progress(k, set.steps);
         if k % set.every == 0 || k == set.steps {
-            csv.row(sys, it.state(), it.augment())?;
+            if let Some(csv) = csv.as_mut() {
+                csv.row(sys, it.state(), it.augment())?;
+            }
             look(it.state(), it.augment());
             rows += 1;
         }
@@ -392,7 +422,9 @@ pub fn run_observed(
         Err(solve::Stop::Failed(f)) => return Err(fail(f, &mut csv, warnings, rows)),
         Err(solve::Stop::Stopped(e)) => return Err(io_fail(e, rows)),
     }
-    csv.flush().map_err(|e| io_fail(e, rows))?;
+    if let Some(csv) = csv.as_mut() {
+        csv.flush().map_err(|e| io_fail(e, rows))?;
+    }
     Ok(RunReport {
         stats: hht.stats().clone(),
         warnings,

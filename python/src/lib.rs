@@ -223,20 +223,24 @@ fn run(
     let r = request(solve)?;
     let out = interruptible(py, move || -> Result<Ran, String> {
         let c = compile(&name, &text, &sets, r)?;
-        let mut csv = Vec::new();
-        let cpu = mbd::study::thread_cpu_seconds();
-        let ran = mbd::run(&c, &mut csv);
-        let cpu_s = mbd::study::thread_cpu_seconds() - cpu;
-        let (header, rows) = mbd::output::read_csv(&String::from_utf8_lossy(&csv))
-            .unwrap_or_else(|_| (Vec::new(), Vec::new()));
-        let data: Vec<u8> = rows
-            .iter()
-            .flatten()
-            .flat_map(|x| x.to_le_bytes())
+        // The rows' values as the CSV holds them (`t`, then the channels; `+ 0.0` turns a
+        // negative zero into zero), taken without the text.
+        let channels = &c.lowered.system.channels;
+        let header: Vec<String> = std::iter::once("t".to_string())
+            .chain(channels.iter().map(|ch| ch.column.clone()))
             .collect();
+        let (mut values, mut rows) = (Vec::<f64>::new(), 0usize);
+        let cpu = mbd::study::thread_cpu_seconds();
+        let ran = mbd::run_values(&c, &mut |_, _| {}, &mut |st, row| {
+            values.push(st.t + 0.0);
+            values.extend(row.iter().map(|x| x + 0.0));
+            rows += 1;
+        });
+        let cpu_s = mbd::study::thread_cpu_seconds() - cpu;
+        let data: Vec<u8> = values.iter().flat_map(|x| x.to_le_bytes()).collect();
         let mut done = Ran {
             header,
-            rows: rows.len(),
+            rows,
             data,
             cpu_s,
             stats: None,
