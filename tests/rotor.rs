@@ -121,20 +121,25 @@ fn windmill_reference_is_converged() {
 }
 
 /// No error floor (issue 20, item 4): the windmill's error against its reference keeps falling
-/// at HHT's second order as the step halves from 50 to 12.5 us (1 s of P5). It used to stop
-/// falling at 25 us and grow as `1/h^2` below: the SE(3) increment's `(1 - cos t) / t^2` lost
-/// `1e-16 / t^2` of itself to cancellation at a step's rotation `t = Omega h` (1.2e-4 rad), and
-/// the drive's angle, 27.8 rad at 3 s, rounded each step's rotation of the hub by its `ulp`.
-/// Measured: orders 2.00 and 2.00 (the largest error over the channels 6.9e-7, 1.7e-7 and
-/// 4.3e-8 of the peak); before, 0.29 and -0.78 (6.9e-7, 5.7e-7 and 9.7e-7).
+/// at HHT's second order as the step halves from 50 to 3.125 us (1 s of P5), to 2.7e-9 of the
+/// peak. It used to stop falling at 25 us and grow as `1/h^2` below (the SE(3) increment's
+/// `(1 - cos t) / t^2` lost `1e-16 / t^2` of itself to cancellation at a step's rotation
+/// `t = Omega h`, and the drive's angle, 27.8 rad at 3 s, rounded each step's rotation of the
+/// hub by its `ulp`); then, with those fixed, at 6.25 us (at about 1e-8 of the peak, growing as
+/// `1/h`): the accelerations came from the step's increment less `h v`, whose rounding is the
+/// same every step of a steady spin, and the rotations' re-orthonormalization turned them by
+/// a rounding that changed sides at `pi`. Measured: orders 2.00, 2.00, 2.00 and 2.00 (the
+/// largest error over the channels 6.9e-7, 1.7e-7, 4.3e-8, 1.1e-8 and 2.7e-9 of the peak);
+/// at 1.5625 us, 1.1e-9 (the lag angles, 1e-13 rad).
 #[test]
 fn windmill_error_falls_at_second_order_down_to_fine_steps() {
-    let errors: Vec<f64> = [5e-5, 2.5e-5, 1.25e-5]
+    let errors: Vec<f64> = [5e-5, 2.5e-5, 1.25e-5, 6.25e-6, 3.125e-6]
         .iter()
         .map(|&dt| {
             let request = Request {
                 dt: Some(dt),
                 until: Some(1.0),
+                every: Some((5e-4 / dt).round() as usize),
                 ..Request::default()
             };
             let tr = simulate("models/windmill.mbd", &[], request);
@@ -155,7 +160,34 @@ fn windmill_error_falls_at_second_order_down_to_fine_steps() {
         let order = (pair[0] / pair[1]).log2();
         above(&format!("observed order {order:.2}"), order, 1.9);
     }
-    within("error at 12.5 us", errors[2], 1.3e-7); // measured 4.3e-8
+    within("error at 3.125 us", errors[4], 8e-9); // measured 2.7e-9
+}
+
+/// A steady spin stays steady (issue 20, item 4): the windmill without its pulse, whose exact
+/// motion keeps the hub still and every lag angle zero, at 25 us steps for 1 s (40,000 steps).
+/// Measured: 3.4e-14 rad at most on the lag angles, 6.0e-15 m on the hub (round-off).
+/// Before the accelerations were carried (the increment less `h v` amplified by `1/(beta h^2)`)
+/// the collective lag reached 1.3e-11 rad, growing as `1/h`; with them carried but the
+/// rotations re-orthonormalized through the quaternion, 1.7e-13 rad.
+#[test]
+fn windmill_spinning_undisturbed_stays_steady() {
+    let request = Request {
+        dt: Some(2.5e-5),
+        until: Some(1.0),
+        every: Some(400),
+        ..Request::default()
+    };
+    let tr = simulate("models/windmill.mbd", &["pulse_peak=0"], request);
+    let largest = |name: &str| tr.col(name).iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let lag = (1..=4)
+        .map(|i| largest(&format!("zeta{i}")))
+        .fold(0.0, f64::max);
+    eprintln!(
+        "undisturbed spin: lag {lag:.3e} rad, hub {:.3e} m",
+        largest("x_hub")
+    );
+    within("largest lag angle (rad)", lag, 1e-13); // measured 3.4e-14
+    within("hub (m)", largest("x_hub"), 2e-14); // measured 6.0e-15
 }
 
 /// P5 as shipped, four blades, stable (Omega_bar = 1: all roots neutral). Measured: every

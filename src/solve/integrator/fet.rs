@@ -219,7 +219,7 @@ impl Integrator<'_> {
         solved?;
         std::mem::swap(&mut self.cur, &mut self.trial);
         for k in 0..self.sys.rotations.len() {
-            let r = rot::orthonormalize(&self.cur.rot[k].matrix());
+            let r = rot::reorthogonalize(&self.cur.rot[k].matrix());
             self.cur.rot[k].set_matrix(&r);
         }
         self.check_finite()

@@ -73,18 +73,28 @@ impl Scheme {
     /// acceleration, previous algorithmic acceleration) -> (rate, acceleration, algorithmic
     /// acceleration). Linear in all four.
     pub(super) fn relation(&self, h: f64, dq: f64, v: f64, a: f64, alg0: f64) -> (f64, f64, f64) {
-        let Scheme {
-            am,
-            af,
-            beta,
-            gamma,
-        } = *self;
+        let beta = self.beta;
         let alg = (dq - h * v - h * h * (0.5 - beta) * alg0) / (beta * h * h);
+        let (v, a) = self.rates(h, v, a, alg0, alg);
+        (v, a, alg)
+    }
+
+    /// The rate and acceleration at the step's end from its algorithmic acceleration `alg`
+    /// (and the start's rate, acceleration and algorithmic acceleration).
+    #[inline]
+    pub(super) fn rates(&self, h: f64, v: f64, a: f64, alg0: f64, alg: f64) -> (f64, f64) {
+        let Scheme { am, af, gamma, .. } = *self;
         (
             v + h * ((1.0 - gamma) * alg0 + gamma * alg),
             ((1.0 - am) * alg + am * alg0 - af * a) / (1.0 - af),
-            alg,
         )
+    }
+
+    /// A step's increment from the start's rate and algorithmic acceleration and the end's
+    /// algorithmic acceleration.
+    #[inline]
+    pub(super) fn increment(&self, h: f64, v: f64, alg0: f64, alg: f64) -> f64 {
+        h * v + h * h * ((0.5 - self.beta) * alg0 + self.beta * alg)
     }
 
     /// A step's increment of one unknown from its rate, acceleration and algorithmic
@@ -97,12 +107,24 @@ impl Scheme {
         (v, a, alg0): (f64, f64, f64),
         (past, slot): (&History, usize),
     ) -> f64 {
+        self.predicted_pair(h, predictor, (v, a, alg0), (past, slot))
+            .0
+    }
+
+    /// The predicted increment and the algorithmic acceleration it implies.
+    pub(super) fn predicted_pair(
+        &self,
+        h: f64,
+        predictor: Predictor,
+        (v, a, alg0): (f64, f64, f64),
+        (past, slot): (&History, usize),
+    ) -> (f64, f64) {
         let alg = match predictor {
-            Predictor::Velocity => return h * v,
+            Predictor::Velocity => return (h * v, -(0.5 - self.beta) / self.beta * alg0),
             Predictor::Acceleration => (a - self.am * alg0) / (1.0 - self.am),
             Predictor::Extrapolated(p) => past.extrapolate(p, slot, alg0),
         };
-        h * v + h * h * ((0.5 - self.beta) * alg0 + self.beta * alg)
+        (self.increment(h, v, alg0, alg), alg)
     }
 
     /// `d a_{n+1} / d q_{n+1}`.
@@ -147,9 +169,9 @@ impl Integrator<'_> {
         tr.t = cur.t + h;
         let step = |v: f64, a: f64, alg0: f64, slot: usize| {
             if hold {
-                0.0
+                (0.0, 0.0)
             } else {
-                sc.predicted(h, predictor, (v, a, alg0), (past, slot))
+                sc.predicted_pair(h, predictor, (v, a, alg0), (past, slot))
             }
         };
         for i in 0..n {
@@ -164,7 +186,7 @@ impl Integrator<'_> {
             } else {
                 tr.lambda[i] = 0.0;
                 if !self.in_frame[i] {
-                    self.step_q[i] = step(cur.v[i], cur.a[i], cur.alg[i], i);
+                    (self.step_q[i], tr.alg[i]) = step(cur.v[i], cur.a[i], cur.alg[i], i);
                     advance(self.is_angle[i], cur, tr, i, self.step_q[i]);
                 }
             }
@@ -172,14 +194,16 @@ impl Integrator<'_> {
         if self.layout == Layout::Increments {
             for k in 0..self.sys.rotations.len() {
                 let f = cur.frames[k];
-                let d: [f64; 6] =
-                    std::array::from_fn(|j| step(f.v[j], f.dv[j], f.alg[j], past.frame_slot(k, j)));
-                // Non-frames' translations are coordinates, in `step_q`.
-                self.step_frames[k] = if self.sys.is_frame(k) {
-                    d
-                } else {
-                    [0.0, 0.0, 0.0, d[3], d[4], d[5]]
-                };
+                let frame = self.sys.is_frame(k);
+                let mut d = [0.0; 6];
+                for j in 0..6 {
+                    // Non-frames' translations are coordinates, in `step_q`.
+                    (d[j], tr.frames[k].alg[j]) = match frame || j >= 3 {
+                        true => step(f.v[j], f.dv[j], f.alg[j], past.frame_slot(k, j)),
+                        false => (0.0, 0.0),
+                    };
+                }
+                self.step_frames[k] = d;
                 se3::displace(self.sys, cur, tr, k, &d);
             }
         }
@@ -352,12 +376,21 @@ impl Integrator<'_> {
         let conformal = self.layout == Layout::Conformal;
         let mut dmax = 0.0f64;
         let (cur, tr) = (&self.cur, &mut self.trial);
-        // Coordinates move by the step's increment, kept apart (see `se3::compose`).
+        // Each correction moves the algorithmic accelerations by its own size over
+        // `beta h^2`: they never come from the increment less its predictable part, whose
+        // round-off (`ulp(h v)`, the same every step of a steady spin) `1/(beta h^2)` would
+        // amplify into a steady load (`se3::increment`).
+        let inv = match self.method {
+            Method::Static => 0.0,
+            _ => 1.0 / (self.sc.beta * h * h),
+        };
+        // Coordinates move by the step's increment, kept apart (see `se3::increment`).
         for i in 0..n {
             let d = self.rhs[i];
             let angle = self.is_angle[i];
             let shift = |tr: &mut State, step: &mut [f64]| {
                 step[i] += d;
+                tr.alg[i] += d * inv;
                 advance(angle, cur, tr, i, step[i]);
             };
             match self.sys.unknowns[i] {
@@ -393,7 +426,12 @@ impl Integrator<'_> {
                     rhs[r + 1],
                     rhs[r + 2],
                 ];
-                self.step_frames[k] = se3::compose(self.sys, k, &self.step_frames[k], &d);
+                let dd = se3::increment(self.sys, k, &self.step_frames[k], &d);
+                let (step, alg) = (&mut self.step_frames[k], &mut tr.frames[k].alg);
+                for j in 0..6 {
+                    step[j] += dd[j];
+                    alg[j] += dd[j] * inv;
+                }
                 se3::displace(self.sys, cur, tr, k, &self.step_frames[k]);
             }
         }
@@ -415,7 +453,7 @@ impl Integrator<'_> {
             rotations::sync(self.sys, &mut self.cur);
         } else {
             for k in 0..self.sys.rotations.len() {
-                let r = rot::orthonormalize(&self.cur.rot[k].matrix());
+                let r = rot::reorthogonalize(&self.cur.rot[k].matrix());
                 self.cur.rot[k].set_matrix(&r);
             }
         }
@@ -443,32 +481,31 @@ impl Integrator<'_> {
         }
     }
 
-    /// Updates velocities and accelerations of the iterate from its positions (Newmark).
+    /// Updates velocities and accelerations of the iterate from its algorithmic
+    /// accelerations (Newmark; the increments hold the same relation, see
+    /// `newmark_correct`).
     pub(super) fn newmark(&mut self, h: f64) {
         if self.method == Method::Static {
             self.static_rates();
             return;
         }
-        let (sc, h) = (self.sc, h);
-        let relation = |dq: f64, v: f64, a: f64, alg0: f64| sc.relation(h, dq, v, a, alg0);
+        let sc = self.sc;
         let (cur, tr) = (&self.cur, &mut self.trial);
         for i in 0..self.sys.len() {
             if self.in_frame[i] || self.sys.unknowns[i].is_multiplier() {
                 continue;
             }
-            let (v, a, alg) = relation(self.step_q[i], cur.v[i], cur.a[i], cur.alg[i]);
-            (tr.v[i], tr.a[i], tr.alg[i]) = (v, a, alg);
+            (tr.v[i], tr.a[i]) = sc.rates(h, cur.v[i], cur.a[i], cur.alg[i], tr.alg[i]);
         }
         if self.layout == Layout::Conformal {
             rotations::sync(self.sys, tr);
             return;
         }
         for k in 0..self.sys.rotations.len() {
-            let d = self.step_frames[k];
             let f0 = cur.frames[k];
             let f = &mut tr.frames[k];
             for j in 0..6 {
-                (f.v[j], f.dv[j], f.alg[j]) = relation(d[j], f0.v[j], f0.dv[j], f0.alg[j]);
+                (f.v[j], f.dv[j]) = sc.rates(h, f0.v[j], f0.dv[j], f0.alg[j], f.alg[j]);
             }
             se3::to_physical(self.sys, tr, k);
         }

@@ -131,7 +131,26 @@ impl Integrator<'_> {
         for k in 0..self.sys.rotations.len() {
             super::se3::displace(self.sys, cur, tr, k, &self.step_frames[k]);
         }
-        self.newmark(h);
+        self.rates_from_increments(h);
+    }
+
+    /// The trial state's rates from the step's increments by the Newmark relations.
+    fn rates_from_increments(&mut self, h: f64) {
+        let sc = self.sc;
+        let (cur, tr) = (&self.cur, &mut self.trial);
+        for i in 0..self.sys.len() {
+            if !self.in_frame[i] && !self.sys.unknowns[i].is_multiplier() {
+                let (v, a, alg) = sc.relation(h, self.step_q[i], cur.v[i], cur.a[i], cur.alg[i]);
+                (tr.v[i], tr.a[i], tr.alg[i]) = (v, a, alg);
+            }
+        }
+        for k in 0..self.sys.rotations.len() {
+            let (d, f0, f) = (self.step_frames[k], cur.frames[k], &mut tr.frames[k]);
+            for j in 0..6 {
+                (f.v[j], f.dv[j], f.alg[j]) = sc.relation(h, d[j], f0.v[j], f0.dv[j], f0.alg[j]);
+            }
+            super::se3::to_physical(self.sys, tr, k);
+        }
     }
 
     /// The step's map at its converged increment, `T dir` and `D x`, against central
