@@ -218,12 +218,6 @@ impl Assembler {
         frames_only: bool,
         kept: bool,
     ) {
-        let rates = |mass: f64, velocity: f64, force_weight: f64| TangentCoeffs {
-            mass,
-            velocity,
-            position: 0.0,
-            force_weight,
-        };
         let take = |k: usize| !frames_only || sys.is_frame(k);
         for (e, nodes) in &self.rated {
             if !nodes.iter().any(|&(k, _)| take(k)) {
@@ -236,8 +230,8 @@ impl Assembler {
             let (m, c) = match held {
                 Some(o) => self.rate_local[o..o + 2 * nl2].split_at(nl2),
                 None => {
-                    el.tangent(st, aug, rates(1.0, 0.0, w), &mut self.local[..nl2]);
-                    el.tangent(st, aug, rates(0.0, 1.0, w), &mut self.local2[..nl2]);
+                    let (m, c) = (&mut self.local[..nl2], &mut self.local2[..nl2]);
+                    el.rate_jacobians(st, aug, w, m, c);
                     (&self.local[..nl2], &self.local2[..nl2])
                 }
             };
@@ -314,18 +308,11 @@ impl Assembler {
         if self.rate_local.len() != size {
             self.rate_local.resize(size, 0.0);
         }
-        let rates = |mass: f64, velocity: f64| TangentCoeffs {
-            mass,
-            velocity,
-            position: 0.0,
-            force_weight: 1.0,
-        };
         let mut at = 0;
         for &e in &self.reading.0 {
             let nl2 = self.indices[e].len().pow(2);
             let (m, rest) = self.rate_local[at..at + 2 * nl2].split_at_mut(nl2);
-            sys.elements[e].tangent(st, aug, rates(1.0, 0.0), m);
-            sys.elements[e].tangent(st, aug, rates(0.0, 1.0), rest);
+            sys.elements[e].rate_jacobians(st, aug, 1.0, m, rest);
             at += 2 * nl2;
         }
     }
@@ -418,6 +405,29 @@ impl Assembler {
         for (e, map) in sys.elements.iter().zip(&self.maps) {
             let nl2 = map.len();
             e.tangent(st, aug, c, &mut self.local[..nl2]);
+            for (slot, v) in map.iter().zip(&self.local[..nl2]) {
+                if let Some(x) = self.values.get_mut(*slot) {
+                    *x += v;
+                }
+            }
+        }
+    }
+
+    /// [`Assembler::residual`] and [`Assembler::tangent`] at one state in one pass over the
+    /// elements (the same values: each element adds its parts in the same order).
+    pub fn residual_and_tangent(
+        &mut self,
+        sys: &System,
+        st: &State,
+        aug: Augment,
+        c: TangentCoeffs,
+    ) {
+        self.residual.clear();
+        self.values.iter_mut().for_each(|x| *x = 0.0);
+        for (e, map) in sys.elements.iter().zip(&self.maps) {
+            let nl2 = map.len();
+            let k = &mut self.local[..nl2];
+            e.residual_and_tangent(st, aug, c, &mut self.residual, k);
             for (slot, v) in map.iter().zip(&self.local[..nl2]) {
                 if let Some(x) = self.values.get_mut(*slot) {
                     *x += v;

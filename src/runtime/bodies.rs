@@ -97,7 +97,24 @@ impl RigidBody {
     }
 
     pub fn residual(&self, st: &State, r: &mut Residual) {
-        let k = self.kin(st);
+        self.residual_at(&self.kin(st), r);
+    }
+
+    /// [`RigidBody::residual`] and [`RigidBody::tangent`] from one evaluation of the
+    /// kinematics.
+    pub fn residual_and_tangent(
+        &self,
+        st: &State,
+        c: TangentCoeffs,
+        r: &mut Residual,
+        k: &mut [f64],
+    ) {
+        let kin = self.kin(st);
+        self.residual_at(&kin, r);
+        self.tangent_at(&kin, c, k);
+    }
+
+    fn residual_at(&self, k: &Kin, r: &mut Residual) {
         let (wt, dwt) = (tilde(&k.w), tilde(&k.dw));
         let g = V3::from(self.gravity);
         let fu = self.mass * k.a + (dwt + wt * wt) * k.meta;
@@ -113,7 +130,10 @@ impl RigidBody {
 
     /// `mass M + velocity G + position K^I + force_weight position K^grav` (THEORY §3.6, §4).
     pub fn tangent(&self, st: &State, c: TangentCoeffs, k: &mut [f64]) {
-        let kin = self.kin(st);
+        self.tangent_at(&self.kin(st), c, k);
+    }
+
+    fn tangent_at(&self, kin: &Kin, c: TangentCoeffs, k: &mut [f64]) {
         let (wt, dwt, at) = (tilde(&kin.w), tilde(&kin.dw), tilde(&kin.a));
         let et = tilde(&kin.meta);
         let jw = kin.j * kin.w;
@@ -148,6 +168,30 @@ impl RigidBody {
         for (r0, c0, b) in blocks {
             add_block(k, 6, r0, c0, &b);
         }
+    }
+
+    /// [`RigidBody::tangent`]'s mass part `M` (unit mass coefficient) into `m` and its
+    /// gyroscopic part `G` (unit velocity coefficient) into `c`, from one evaluation of the
+    /// kinematics.
+    pub fn rate_jacobians(&self, st: &State, m: &mut [f64], c: &mut [f64]) {
+        let kin = self.kin(st);
+        let wt = tilde(&kin.w);
+        let et = tilde(&kin.meta);
+        let g_ut = tilde(&(wt * kin.meta)).transpose() + wt * et.transpose();
+        let g_tt = wt * kin.j - tilde(&(kin.j * kin.w));
+        m[..36].iter_mut().for_each(|x| *x = 0.0);
+        c[..36].iter_mut().for_each(|x| *x = 0.0);
+        let m_uu = M3::identity() * self.mass;
+        for (r0, c0, b) in [
+            (0, 0, &m_uu),
+            (0, 3, &et.transpose()),
+            (3, 0, &et),
+            (3, 3, &kin.j),
+        ] {
+            add_block(m, 6, r0, c0, b);
+        }
+        add_block(c, 6, 0, 3, &g_ut);
+        add_block(c, 6, 3, 3, &g_tt);
     }
 
     /// Adds the momenta `(m v + w x m eta, J w + m eta x v)` and the transport term

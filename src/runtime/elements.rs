@@ -82,6 +82,53 @@ impl Element {
         }
     }
 
+    /// [`Element::residual`] into `r` and [`Element::tangent`] into `k` at one state, sharing
+    /// what they both evaluate (a joint's rows' geometry, a rigid body's kinematics).
+    pub fn residual_and_tangent(
+        &self,
+        st: &State,
+        aug: Augment,
+        c: TangentCoeffs,
+        r: &mut Residual,
+        k: &mut [f64],
+    ) {
+        match self {
+            Element::RigidBody(b) => b.residual_and_tangent(st, c, r, k),
+            Element::Joint(j) => j.residual_and_tangent(st, aug, c, r, k),
+            e => {
+                e.residual(st, aug, r);
+                e.tangent(st, aug, c, k);
+            }
+        }
+    }
+
+    /// Writes the tangent's derivatives with respect to the accelerations (`m`: unit mass
+    /// coefficient) and the velocities (`c`: unit velocity coefficient, the damping weighted
+    /// by `force_weight`) into `m` and `c`, as [`Element::tangent`] with those coefficients
+    /// alone writes them; a rigid body makes its kinematics once for both.
+    pub fn rate_jacobians(
+        &self,
+        st: &State,
+        aug: Augment,
+        force_weight: f64,
+        m: &mut [f64],
+        c: &mut [f64],
+    ) {
+        let rates = |mass: f64, velocity: f64| TangentCoeffs {
+            mass,
+            velocity,
+            position: 0.0,
+            force_weight,
+        };
+        match self {
+            Element::RigidBody(b) => b.rate_jacobians(st, m, c),
+            e => {
+                e.tangent(st, aug, rates(1.0, 0.0), m);
+                e.tangent(st, aug, rates(0.0, 1.0), c);
+            }
+        }
+    }
+
     /// Writes the local tangent (row-major, `indices().len()` squared) into `k`.
     pub fn tangent(&self, st: &State, aug: Augment, c: TangentCoeffs, k: &mut [f64]) {
         match self {

@@ -254,24 +254,30 @@ fn perturb(st: &State, j: usize, eps: f64, c: TangentCoeffs) -> State {
     s
 }
 
+/// Random integrator coefficients and penalty.
+fn coefficients(rng: &mut Lcg) -> (TangentCoeffs, Augment) {
+    let c = TangentCoeffs {
+        mass: 1.0 + 5.0 * rng.next().abs(),
+        velocity: 0.5 + 2.0 * rng.next().abs(),
+        // Newton's unknowns are the positions: the constraint rows are `s B` for a unit
+        // position weight (TangentCoeffs).
+        position: 1.0,
+        force_weight: 0.8 + 0.2 * rng.next().abs(),
+    };
+    let aug = Augment {
+        s: 1.0 + 3.0 * rng.next().abs(),
+        p: 1.0 + 3.0 * rng.next().abs(),
+        rate_scale: 1.0 / c.velocity,
+    };
+    (c, aug)
+}
+
 #[test]
 fn tangents_match_central_differences() {
     let mut rng = Lcg(7);
     let rate_rows: Vec<bool> = all_rows().iter().map(Row::is_rate).collect();
     for case in 0..60 {
-        let c = TangentCoeffs {
-            mass: 1.0 + 5.0 * rng.next().abs(),
-            velocity: 0.5 + 2.0 * rng.next().abs(),
-            // Newton's unknowns are the positions: the constraint rows are `s B` for a unit
-            // position weight (TangentCoeffs).
-            position: 1.0,
-            force_weight: 0.8 + 0.2 * rng.next().abs(),
-        };
-        let aug = Augment {
-            s: 1.0 + 3.0 * rng.next().abs(),
-            p: 1.0 + 3.0 * rng.next().abs(),
-            rate_scale: 1.0 / c.velocity,
-        };
+        let (c, aug) = coefficients(&mut rng);
         let mut st = random_state(&mut rng);
         if case % 4 == 3 {
             // The element's two nodes turned alike, up to 0.3 rad.
@@ -312,6 +318,48 @@ fn tangents_match_central_differences() {
                     );
                 }
             }
+        }
+    }
+}
+
+/// `Element::residual_and_tangent` writes exactly what `residual` and `tangent` write apart,
+/// and `Element::rate_jacobians` what `tangent` writes with a unit mass or velocity
+/// coefficient alone: every element, dropped and rate rows, ends between beam nodes.
+#[test]
+fn one_pass_residual_and_tangent_and_rate_jacobians_equal_the_parts() {
+    let mut rng = Lcg(11);
+    for case in 0..16 {
+        let (c, aug) = coefficients(&mut rng);
+        let st = random_state(&mut rng);
+        for el in elements(&mut rng, case) {
+            let nl2 = el.indices().len().pow(2);
+            let (mut r1, mut r2) = (Residual::new(N), Residual::new(N));
+            let (mut k1, mut k2) = (vec![0.0; nl2], vec![f64::NAN; nl2]);
+            el.residual(&st, aug, &mut r1);
+            el.tangent(&st, aug, c, &mut k1);
+            el.residual_and_tangent(&st, aug, c, &mut r2, &mut k2);
+            assert_eq!(
+                (&r1.inertia, &r1.force, &r1.constraint),
+                (&r2.inertia, &r2.force, &r2.constraint)
+            );
+            assert_eq!(k1, k2, "case {case}: {:?}", std::mem::discriminant(&el));
+            let unit = |mass: f64, velocity: f64| TangentCoeffs {
+                mass,
+                velocity,
+                position: 0.0,
+                force_weight: c.force_weight,
+            };
+            let (mut m1, mut c1) = (vec![0.0; nl2], vec![0.0; nl2]);
+            el.tangent(&st, aug, unit(1.0, 0.0), &mut m1);
+            el.tangent(&st, aug, unit(0.0, 1.0), &mut c1);
+            let (mut m2, mut c2) = (vec![f64::NAN; nl2], vec![f64::NAN; nl2]);
+            el.rate_jacobians(&st, aug, c.force_weight, &mut m2, &mut c2);
+            assert_eq!(
+                (m1, c1),
+                (m2, c2),
+                "case {case}: {:?}",
+                std::mem::discriminant(&el)
+            );
         }
     }
 }

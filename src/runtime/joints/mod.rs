@@ -10,7 +10,7 @@
 
 use super::rotation::{tilde, M3, V3};
 use super::timefn::TimeFn;
-use super::{Augment, Rate, Residual, State, TangentCoeffs};
+use super::{Augment, Rate, Residual, State};
 use serde::{Deserialize, Serialize};
 
 /// Slots of the 13-component generalized vectors of a joint.
@@ -27,6 +27,7 @@ pub(crate) type Hess = [[f64; SLOTS]; SLOTS];
 mod ends;
 mod outputs;
 mod redundant;
+mod tangent;
 
 pub use ends::{Between, End, EndKin};
 pub(crate) use ends::{Geo, Spreads};
@@ -358,11 +359,7 @@ impl Joint {
         let glob = globals(&self.a, &self.b, self.angle);
         for (k, row) in self.rows.iter().enumerate() {
             let (mu, gr) = self.row_residual(k, row, &geo, st, aug, r);
-            for (s, gi) in glob.iter().enumerate() {
-                if let Some(i) = gi {
-                    r.force[*i] += mu * gr[s];
-                }
-            }
+            add_force(&glob, mu, &gr, r);
         }
     }
 
@@ -395,15 +392,32 @@ impl Joint {
         }
         let (gv, gr) = row.geom(geo);
         let f = row.drive().map_or(0.0, |f| f.eval(st.t));
-        let mu = if row.is_rate() {
-            r.constraint[m] = aug.rate_scale * (dot13(&gr, &geo.vel) - f);
+        (
+            Self::row_equation(m, row, (gv, &gr, f), geo, st, aug, r),
+            gr,
+        )
+    }
+
+    /// Row equation `m` (its value `gv`, gradient `gr` and drive `f`) into `r.constraint`;
+    /// its force `mu`.
+    #[inline(always)]
+    fn row_equation(
+        m: usize,
+        row: &Row,
+        (gv, gr, f): (f64, &Grad, f64),
+        geo: &Geo,
+        st: &State,
+        aug: Augment,
+        r: &mut Residual,
+    ) -> f64 {
+        if row.is_rate() {
+            r.constraint[m] = aug.rate_scale * (dot13(gr, &geo.vel) - f);
             aug.s * st.lambda[m]
         } else {
             let c = gv - f;
             r.constraint[m] = c;
             aug.s * st.lambda[m] + aug.p * c
-        };
-        (mu, gr)
+        }
     }
 
     /// The residual with an end between beam nodes: the rows' forces summed on the slots, then
@@ -418,102 +432,6 @@ impl Joint {
         }
         let sp = Spreads::new(&self.a, &self.b, self.angle, st);
         sp.add_forces(&force, (&self.a, &self.b, self.angle), &mut r.force);
-    }
-
-    pub fn tangent(&self, st: &State, aug: Augment, c: TangentCoeffs, k: &mut [f64]) {
-        let geo = Geo::new(&self.a, &self.b, self.angle, st);
-        let (map, m0) = slots(&self.a, &self.b, self.angle);
-        // Ends between beam nodes reach several unknowns per slot.
-        let spread = (self.a.is_between() || self.b.is_between())
-            .then(|| Spreads::new(&self.a, &self.b, self.angle, st));
-        let nl = m0 + self.rows.len();
-        k[..nl * nl].iter_mut().for_each(|x| *x = 0.0);
-        let w = c.force_weight;
-        // The slots this joint assembles, with their local positions (plain ends).
-        let mut live = [(0usize, 0usize); SLOTS];
-        let mut nlive = 0;
-        for (s, l) in map.iter().enumerate() {
-            if let Some(l) = l {
-                live[nlive] = (s, *l);
-                nlive += 1;
-            }
-        }
-        let live = &live[..nlive];
-        // Every row's geometric stiffness and the penalty's `p grad G grad G^T`, summed over
-        // the rows and assembled once with the weight `w c_q`.
-        let mut h = [[0.0; SLOTS]; SLOTS];
-        for (r, row) in self.rows.iter().enumerate() {
-            let m = m0 + r;
-            if self.is_dropped(r, st) {
-                k[m * nl + m] = aug.s;
-                continue;
-            }
-            let (gv, gr) = row.geom(&geo);
-            let lam = st.lambda[self.first + r];
-            // The row's derivative over the slots (a rate row's through the velocities too:
-            // its `s B` part).
-            let mut dc = [0.0; SLOTS];
-            if row.is_rate() {
-                row.hess(&geo, aug.s * lam, &mut h);
-                let mut h1 = [[0.0; SLOTS]; SLOTS];
-                row.hess(&geo, 1.0, &mut h1);
-                for &(sj, _) in live {
-                    let vh: f64 = (0..SLOTS).map(|si| geo.vel[si] * h1[si][sj]).sum();
-                    // `rate_scale` is `1 / velocity` (the integrator's `beta h / gamma`): the
-                    // row is `s (B + rate_scale position V^T H)`, a unit-weight `s B` in the
-                    // constrained mass matrix too.
-                    dc[sj] = aug.s * (gr[sj] + aug.rate_scale * c.position * vh);
-                }
-            } else {
-                let f = row.drive().map_or(0.0, |f| f.eval(st.t));
-                row.hess(&geo, aug.s * lam + aug.p * (gv - f), &mut h);
-                for &(sj, _) in live {
-                    dc[sj] = aug.s * gr[sj];
-                }
-                for &(si, _) in live {
-                    let g = aug.p * gr[si];
-                    if g != 0.0 {
-                        for &(sj, _) in live {
-                            h[si][sj] += g * gr[sj];
-                        }
-                    }
-                }
-            }
-            match &spread {
-                None => {
-                    for &(s, l) in live {
-                        k[m * nl + l] = dc[s];
-                        k[l * nl + m] = w * aug.s * gr[s];
-                    }
-                }
-                Some(sp) => {
-                    for &(s, _) in live {
-                        // The velocities' part through their interpolation.
-                        let dv = if row.is_rate() { aug.s * gr[s] } else { 0.0 };
-                        for (l, cl) in sp.trial[s].iter() {
-                            k[m * nl + l] += (dc[s] - dv) * cl;
-                        }
-                        for (l, cl) in sp.rate[s].iter() {
-                            k[m * nl + l] += dv * cl;
-                        }
-                        for (l, cl) in sp.test[s].iter() {
-                            k[l * nl + m] += w * aug.s * gr[s] * cl;
-                        }
-                    }
-                }
-            }
-        }
-        let wc = w * c.position;
-        match &spread {
-            None => {
-                for &(si, li) in live {
-                    for &(sj, lj) in live {
-                        k[li * nl + lj] += wc * h[si][sj];
-                    }
-                }
-            }
-            Some(sp) => sp.add_matrix(&h, wc, false, k, nl),
-        }
     }
 
     pub fn constraint_rate(&self, st: &State, rate: Rate, out: &mut [f64]) {
@@ -554,6 +472,16 @@ pub(crate) fn slots(a: &End, b: &End, angle: Option<usize>) -> ([Option<usize>; 
         at += 1;
     }
     (map, at)
+}
+
+/// A row's force `mu grad` onto the global unknowns of its slots.
+#[inline(always)]
+pub(crate) fn add_force(glob: &[Option<usize>; SLOTS], mu: f64, gr: &Grad, r: &mut Residual) {
+    for (s, gi) in glob.iter().enumerate() {
+        if let Some(i) = gi {
+            r.force[*i] += mu * gr[s];
+        }
+    }
 }
 
 /// The global unknown of each slot (no allocation: called every iteration).

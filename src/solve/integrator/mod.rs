@@ -32,7 +32,7 @@ pub use linearize::Linearization;
 use super::linear::{LinearError, SparseLu};
 use super::{FailureKind, RunStats, RuntimeFailure};
 use crate::runtime::rotation::{M3, V3};
-use crate::runtime::{Assembler, Augment, Residual, State, System};
+use crate::runtime::{Assembler, Augment, Residual, State, System, TangentCoeffs};
 use crate::settings::{Method, NewtonMode, Rotations, Settings};
 use newmark::Scheme;
 use newton::Reuse;
@@ -158,6 +158,12 @@ pub struct Integrator<'s> {
     /// The assembler holds the elements' `M` and `C` at the iterate
     /// ([`crate::runtime::Assembler::rate_jacobians`]): the matrix's rate columns take them.
     rates_held: bool,
+    /// The matrix coefficients for which the next residual also makes the elements' tangent
+    /// (the step's first, where a new matrix follows), and whether the assembler holds the
+    /// tangent that way at the iterate (taken by the next matrix, cleared by other residuals).
+    fused: (Option<TangentCoeffs>, bool),
+    /// The last step took a correction (a steady state's predictor may need none).
+    corrected: bool,
     /// The converged state at the current time.
     cur: State,
     /// The iterate of the step being solved.
@@ -277,6 +283,8 @@ impl<'s> Integrator<'s> {
             smooth: false,
             exact_rates: false,
             rates_held: false,
+            fused: (None, false),
+            corrected: true,
             cur: sys.initial.clone(),
             trial: sys.initial.clone(),
             rhs: vec![0.0; n],
@@ -557,6 +565,7 @@ impl<'s> Integrator<'s> {
     fn converge(&mut self, it: usize, cnorm: f64, aug: Augment, h: f64) -> Result<(), StepFailure> {
         self.stats.newton_iterations += it;
         self.smooth = it <= SMOOTH;
+        (self.corrected, self.fused) = (it > 0, (None, false));
         self.stats.max_constraint_violation = self.stats.max_constraint_violation.max(cnorm);
         self.aug = aug;
         std::mem::swap(&mut self.lambda_prev.0, &mut self.lambda_prev2.0);

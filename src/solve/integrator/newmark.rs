@@ -280,7 +280,16 @@ impl Integrator<'_> {
         floor: f64,
     ) -> Result<Norms, StepFailure> {
         let n = self.sys.len();
-        self.asm.residual(self.sys, &self.trial, aug);
+        self.fused.1 = match self.fused.0.take() {
+            Some(c) => {
+                (self.asm).residual_and_tangent(self.sys, &self.trial, aug, c);
+                true
+            }
+            None => {
+                self.asm.residual(self.sys, &self.trial, aug);
+                false
+            }
+        };
         self.block_matrices();
         let r = &self.asm.residual;
         let (mut scale, mut cnorm) = (floor, 0.0f64);
@@ -322,10 +331,10 @@ impl Integrator<'_> {
         })
     }
 
-    /// The iteration matrix at the iterate, `T^T J T` in the treatment's unknowns.
-    pub(super) fn newmark_matrix(&mut self, h: f64, aug: Augment) {
+    /// The tangent's coefficients for a step of `h`.
+    pub(super) fn newmark_coefficients(&self, h: f64) -> TangentCoeffs {
         let sc = self.sc;
-        let coeffs = if self.method == Method::Static {
+        if self.method == Method::Static {
             Self::static_coefficients()
         } else {
             TangentCoeffs {
@@ -334,8 +343,15 @@ impl Integrator<'_> {
                 position: 1.0,
                 force_weight: 1.0,
             }
-        };
-        self.asm.tangent(self.sys, &self.trial, aug, coeffs);
+        }
+    }
+
+    /// The iteration matrix at the iterate, `T^T J T` in the treatment's unknowns.
+    pub(super) fn newmark_matrix(&mut self, h: f64, aug: Augment) {
+        let coeffs = self.newmark_coefficients(h);
+        if !std::mem::take(&mut self.fused.1) {
+            self.asm.tangent(self.sys, &self.trial, aug, coeffs);
+        }
         // SE(3) frames: the Newmark relations act on body-frame twists, so the inertial
         // terms' columns take how those move with a correction (`se3::rate_maps`).
         if self.layout == Layout::Increments && self.method != Method::Static {

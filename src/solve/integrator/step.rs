@@ -124,6 +124,10 @@ impl Integrator<'_> {
         // Whether the last correction came from a kept matrix, and the residual's total
         // before it.
         let (mut after_kept, mut last_total) = (false, f64::INFINITY);
+        // The first residual makes the tangent with it where a new matrix follows it: under
+        // `full` (no matrix kept before a correction), after a step that needed one.
+        let first = !fet && self.reuse.mode() == NewtonMode::Full && self.corrected;
+        self.fused = (first.then(|| self.newmark_coefficients(h)), false);
         for it in 0..=max {
             let mut r = self.residual(fet, h, aug, newton.floor)?;
             let mut total = r.force + aug.s * r.constraint;
