@@ -95,6 +95,7 @@ impl Element {
         match self {
             Element::RigidBody(b) => b.residual_and_tangent(st, c, r, k),
             Element::Joint(j) => j.residual_and_tangent(st, aug, c, r, k),
+            Element::Load(l) => l.residual_and_tangent(st, c, r, k),
             e => {
                 e.residual(st, aug, r);
                 e.tangent(st, aug, c, k);

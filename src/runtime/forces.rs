@@ -7,7 +7,7 @@
 //! the relative rotation vector of two markers' axes. A [`Load`] is a force or torque at a
 //! marker, fixed in space or following the marker's axes.
 
-use super::joints::{dot13, globals, slots, End, Geo, Grad, Hess, Row, Spreads, SLOTS};
+use super::joints::{dot13, globals, slots, End, EndKin, Geo, Grad, Hess, Row, Spreads, SLOTS};
 use super::rotation::{left_jacobian_inverse, log, tilde, M3, V3};
 use super::timefn::TimeFn;
 use super::{Energy, Residual, State, TangentCoeffs};
@@ -276,12 +276,38 @@ impl Load {
     }
 
     pub fn residual(&self, st: &State, r: &mut Residual) {
-        let d = self.end.dofs();
-        if d.is_empty() {
+        if self.end.dofs().is_empty() {
             return;
         }
         let kin = self.end.kin(st);
         let v = self.value(st, &kin.e);
+        self.residual_at(st, (&kin, v), r);
+    }
+
+    /// [`Load::residual`] and [`Load::tangent`] from one evaluation of the end's kinematics
+    /// and the load's value.
+    pub fn residual_and_tangent(
+        &self,
+        st: &State,
+        c: TangentCoeffs,
+        r: &mut Residual,
+        k: &mut [f64],
+    ) {
+        let n = self.end.dofs().len();
+        if n == 0 {
+            return;
+        }
+        let kin = self.end.kin(st);
+        let v = self.value(st, &kin.e);
+        self.residual_at(st, (&kin, v), r);
+        k[..n * n].iter_mut().for_each(|x| *x = 0.0);
+        if n >= 6 {
+            self.tangent_at(st, (&kin, v), c, k);
+        }
+    }
+
+    fn residual_at(&self, st: &State, (kin, v): (&EndKin, V3), r: &mut Residual) {
+        let d = self.end.dofs();
         // Minus the force and the moment about the end's node (its reference point).
         let (f, m) = match self.kind {
             LoadKind::Force => (-v, -kin.p.cross(&v)),
@@ -312,6 +338,12 @@ impl Load {
         }
         let kin = self.end.kin(st);
         let v = self.value(st, &kin.e);
+        self.tangent_at(st, (&kin, v), c, k);
+    }
+
+    /// Adds the tangent's rotation columns into a zeroed `k`.
+    fn tangent_at(&self, st: &State, (kin, v): (&EndKin, V3), c: TangentCoeffs, k: &mut [f64]) {
+        let n = self.end.dofs().len();
         let (vt, pt) = (tilde(&v), tilde(&kin.p));
         let s = c.force_weight * c.position;
         let (ut, tt) = match (self.kind, self.follower) {
