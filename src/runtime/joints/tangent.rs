@@ -99,12 +99,20 @@ impl Joint {
                 for &(sj, _) in live {
                     dc[sj] = aug.s * gr[sj];
                 }
+                // The penalty's outer product over the slots the row reaches (a row reaches
+                // 1 to 8 of the 13).
+                let mut reach = [0usize; SLOTS];
+                let mut nr = 0;
                 for &(si, _) in live {
+                    if gr[si] != 0.0 {
+                        reach[nr] = si;
+                        nr += 1;
+                    }
+                }
+                for &si in &reach[..nr] {
                     let g = aug.p * gr[si];
-                    if g != 0.0 {
-                        for &(sj, _) in live {
-                            h[si][sj] += g * gr[sj];
-                        }
+                    for &sj in &reach[..nr] {
+                        h[si][sj] += g * gr[sj];
                     }
                 }
             }
