@@ -2,7 +2,7 @@
 //! penalty's `p grad G grad G^T`) and its equation's gradient; with the residual at the same
 //! state when the caller needs both, each row's geometry made once.
 
-use super::{add_force, globals, slots, Geo, Joint, Spreads, SLOTS};
+use super::{add_force, globals, slots, Geo, Grad, Hess, Joint, Spreads, SLOTS};
 use crate::runtime::{Augment, Residual, State, TangentCoeffs};
 
 impl Joint {
@@ -99,22 +99,7 @@ impl Joint {
                 for &(sj, _) in live {
                     dc[sj] = aug.s * gr[sj];
                 }
-                // The penalty's outer product over the slots the row reaches (a row reaches
-                // 1 to 8 of the 13).
-                let mut reach = [0usize; SLOTS];
-                let mut nr = 0;
-                for &(si, _) in live {
-                    if gr[si] != 0.0 {
-                        reach[nr] = si;
-                        nr += 1;
-                    }
-                }
-                for &si in &reach[..nr] {
-                    let g = aug.p * gr[si];
-                    for &sj in &reach[..nr] {
-                        h[si][sj] += g * gr[sj];
-                    }
-                }
+                add_penalty(live, aug.p, &gr, &mut h);
             }
             match &spread {
                 None => {
@@ -150,6 +135,26 @@ impl Joint {
                 }
             }
             Some(sp) => sp.add_matrix(&h, wc, false, k, nl),
+        }
+    }
+}
+
+/// Adds the penalty's outer product `p grad grad^T` to `h` over the live slots the row reaches
+/// (a row reaches 1 to 8 of the 13).
+#[inline(always)]
+fn add_penalty(live: &[(usize, usize)], p: f64, gr: &Grad, h: &mut Hess) {
+    let mut reach = [0usize; SLOTS];
+    let mut nr = 0;
+    for &(si, _) in live {
+        if gr[si] != 0.0 {
+            reach[nr] = si;
+            nr += 1;
+        }
+    }
+    for &si in &reach[..nr] {
+        let g = p * gr[si];
+        for &sj in &reach[..nr] {
+            h[si][sj] += g * gr[sj];
         }
     }
 }

@@ -106,8 +106,18 @@ impl Integrator<'_> {
         second
     }
 
-    /// The Newton iteration of one step from the predictor.
+    /// The Newton iteration of one step from the predictor. A failed one leaves no tangent
+    /// of its iterate for a later matrix to take.
     fn newton(&mut self, h: f64, predictor: Predictor) -> Result<(), StepFailure> {
+        let done = self.iterate(h, predictor);
+        if done.is_err() {
+            self.fused = (None, false);
+        }
+        done
+    }
+
+    /// [`Integrator::newton`]'s iteration.
+    fn iterate(&mut self, h: f64, predictor: Predictor) -> Result<(), StepFailure> {
         let aug = self.scaling(h);
         let rescale = self.aug.s / aug.s;
         let fet = self.method == Method::Fet;
