@@ -228,9 +228,20 @@ fn bricards_linkage_moves_with_one_degree_of_freedom_and_keeps_its_energy() {
     ); // 0.18
        // The passage near 9.6 s (P3 through y = 0 at the highest speed) costs more, and that
        // part does not shrink with the step (see the closing note of issue 23). It amplifies
-       // round-off: over steps of 0.97 to 1.03 ms the 10-s drift spreads from 5e-5 to 1.8e-3
-       // (median 4.9e-4), with either re-orthogonalization of the rotations (issue 20).
-    within("Bricard: energy drift over 10 s at 1 ms", fine.1, 2e-3); // 7.3e-4
+       // round-off: over steps of 0.97 to 1.03 ms the 10-s drift spreads from 5e-5 to 1.6e-3
+       // (to 1.8e-3 with the quaternion's re-orthonormalization; issue 20), and one step's
+       // figure moves with any change in the last bits. The median over seven steps (0.97 to
+       // 1.03 ms by 0.01: 5.3e-5 to 7.3e-4) moves far less.
+    let mut tens: Vec<f64> = [0.97e-3, 0.98e-3, 0.99e-3, 1e-3, 1.01e-3, 1.02e-3, 1.03e-3]
+        .iter()
+        .map(|&dt| if dt == 1e-3 { fine.1 } else { drift(dt, 10).1 })
+        .collect();
+    tens.sort_by(f64::total_cmp);
+    within(
+        "Bricard: energy drift over 10 s, median over 0.97-1.03 ms",
+        tens[3],
+        1.2e-3,
+    ); // 4.0e-4
 }
 
 #[test]
