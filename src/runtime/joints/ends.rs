@@ -81,6 +81,7 @@ impl Between {
             w: V3::zeros(),
             a: V3::zeros(),
             dw: V3::zeros(),
+            turns: true,
         };
         let at = |v: &[f64], d: &[usize]| V3::new(v[d[0]], v[d[1]], v[d[2]]);
         for (j, d) in self.dofs.chunks(6).enumerate() {
@@ -258,6 +259,9 @@ pub struct EndKin {
     /// Acceleration of the node's translation and angular acceleration.
     pub a: V3,
     pub dw: V3,
+    /// The end has rotation slots (a node or a point between nodes): a joint's derivatives
+    /// on `theta` of an end without them are never assembled, and never formed.
+    pub turns: bool,
 }
 
 impl End {
@@ -280,6 +284,7 @@ impl End {
                 w: V3::zeros(),
                 a: V3::zeros(),
                 dw: V3::zeros(),
+                turns: false,
             },
             End::Point { dofs, axes } => EndKin {
                 x: V3::from(dofs.map(|i| st.q[i])),
@@ -289,6 +294,7 @@ impl End {
                 w: V3::zeros(),
                 a: V3::from(dofs.map(|i| st.a[i])),
                 dw: V3::zeros(),
+                turns: false,
             },
             End::Node {
                 dofs,
@@ -307,6 +313,7 @@ impl End {
                     w: n.omega(),
                     a: V3::new(st.a[dofs[0]], st.a[dofs[1]], st.a[dofs[2]]),
                     dw: n.omega_dot(),
+                    turns: true,
                 }
             }
             End::Between(b) => b.kin(st),

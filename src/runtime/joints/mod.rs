@@ -127,34 +127,54 @@ impl Row {
         if mu == 0.0 {
             return;
         }
+        // Blocks on the rotation slots of an end without them (a ground, a point mass) are
+        // never assembled: they are not formed.
+        let (ra, rb) = (g.a.turns, g.b.turns);
         match self {
             Row::Point { k } => {
                 let mut m = V3::zeros();
                 m[*k] = mu;
                 let mt = tilde(&m);
-                block(h, TA, TA, &(-mt * tilde(&g.a.p)));
-                block(h, TB, TB, &(mt * tilde(&g.b.p)));
+                if ra {
+                    block(h, TA, TA, &(-mt * tilde(&g.a.p)));
+                }
+                if rb {
+                    block(h, TB, TB, &(mt * tilde(&g.b.p)));
+                }
             }
             Row::Dot { i, j } => {
                 let (at, bt) = (
                     tilde(&g.a.e.column(*i).into_owned()),
                     tilde(&g.b.e.column(*j).into_owned()),
                 );
-                let (ba, ab) = (bt * at * mu, at * bt * mu);
-                block(h, TA, TA, &ba);
-                block(h, TA, TB, &-ab);
-                block(h, TB, TA, &-ba);
-                block(h, TB, TB, &ab);
+                if ra {
+                    let ba = bt * at * mu;
+                    block(h, TA, TA, &ba);
+                    if rb {
+                        block(h, TB, TA, &-ba);
+                    }
+                }
+                if rb {
+                    let ab = at * bt * mu;
+                    block(h, TB, TB, &ab);
+                    if ra {
+                        block(h, TA, TB, &-ab);
+                    }
+                }
             }
             Row::Along { i, .. } => along_hess(g, *i, mu, h),
             Row::SlideDrive { .. } | Row::SlideRate { .. } => along_hess(g, 2, mu, h),
             Row::Angle => {
                 let an = AngleGeo::new(g);
                 let (da, db) = an.derivatives();
-                block(h, TA, TA, &(da * mu));
-                block(h, TA, TB, &(db * mu));
-                block(h, TB, TA, &(-da * mu));
-                block(h, TB, TB, &(-db * mu));
+                if ra {
+                    block(h, TA, TA, &(da * mu));
+                    block(h, TA, TB, &(db * mu));
+                }
+                if rb {
+                    block(h, TB, TA, &(-da * mu));
+                    block(h, TB, TB, &(-db * mu));
+                }
             }
             Row::Phi | Row::AngleDrive { .. } | Row::AngleRate { .. } => {}
             Row::Distance { .. } => {
@@ -170,12 +190,14 @@ impl Row {
                 // Forces: u_A: -mu n, theta_A: -mu p_A~ n, u_B: mu n, theta_B: mu p_B~ n; each
                 // block is the force's row operator times `proj D_c`. An end without an arm (a
                 // ground, a point mass) has no rotation's blocks: their operator is zero.
+                // (Their products are not even formed: on the pendulum they were 8 % of a step.)
                 let (arm_a, arm_b) = (g.a.p != V3::zeros(), g.b.p != V3::zeros());
+                let arm = |live: bool, x: &dyn Fn() -> M3| if live { x() } else { M3::zeros() };
                 let cols = [
                     (UA, -proj, true),
-                    (TA, proj * pa, arm_a),
+                    (TA, arm(arm_a, &|| proj * pa), arm_a),
                     (UB, proj, true),
-                    (TB, -(proj * pb), arm_b),
+                    (TB, arm(arm_b, &|| -(proj * pb)), arm_b),
                 ];
                 for (c0, x, live) in cols {
                     if !live {
@@ -191,8 +213,12 @@ impl Row {
                     }
                 }
                 let nt = tilde(&n);
-                block(h, TA, TA, &(-nt * pa * mu));
-                block(h, TB, TB, &(nt * pb * mu));
+                if arm_a {
+                    block(h, TA, TA, &(-nt * pa * mu));
+                }
+                if arm_b {
+                    block(h, TB, TB, &(nt * pb * mu));
+                }
             }
         }
     }
@@ -215,14 +241,22 @@ fn along_hess(g: &Geo, i: usize, mu: f64, h: &mut Hess) {
     let at = tilde(&a) * mu;
     let w = g.d() + g.a.p;
     let pbt = tilde(&g.b.p);
-    block(h, UA, TA, &at);
-    block(h, UB, TA, &-at);
-    block(h, TA, UA, &-at);
-    block(h, TA, UB, &at);
-    block(h, TA, TA, &(tilde(&w) * at));
-    block(h, TA, TB, &(-at * pbt));
-    block(h, TB, TB, &(at * pbt));
-    block(h, TB, TA, &(-pbt * at));
+    // As in `Row::hess`: no blocks on an end's missing rotation slots.
+    let (ra, rb) = (g.a.turns, g.b.turns);
+    if ra {
+        block(h, UA, TA, &at);
+        block(h, UB, TA, &-at);
+        block(h, TA, UA, &-at);
+        block(h, TA, UB, &at);
+        block(h, TA, TA, &(tilde(&w) * at));
+        if rb {
+            block(h, TA, TB, &(-at * pbt));
+            block(h, TB, TA, &(-pbt * at));
+        }
+    }
+    if rb {
+        block(h, TB, TB, &(at * pbt));
+    }
 }
 
 fn distance_grad(g: &Geo, n: &V3, gr: &mut Grad) {
