@@ -66,7 +66,7 @@ PROBLEMS = [
          until=1.0, dts=ladder(0.02, 7), period=0.02, channels=["x", "y"],
          build=exudyn_models.pendulum, kwargs={}, sparse=False),
     dict(name="two_bar", title="P3 two-bar, theta2_0 = 0, 50 s", model="models/two_bar.mbd",
-         sets=["theta2_0=0"], until=50.0, dts=ladder(0.0125, 6), period=0.05,
+         sets=["theta2_0=0"], until=50.0, dts=ladder(0.00625, 6), period=0.05,
          channels=["xc2", "yc2", "zc2"], build=exudyn_models.two_bar,
          kwargs=dict(theta2_0=0.0), sparse=False),
     dict(name="windmill_1", title="P5 windmill, Omega_bar = 1, 3 s", model="models/windmill.mbd",
