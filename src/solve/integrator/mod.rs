@@ -136,6 +136,9 @@ pub struct Integrator<'s> {
     /// Per rotating node, how its rates move with a correction beyond the scalar coefficients
     /// ([`se3::rate_maps`]).
     rate_maps: Vec<([f64; 36], [f64; 36])>,
+    /// Per rotating node, the increment's inverse right Jacobian that the last matrix made,
+    /// for the correction after it ([`se3::Jinv`]).
+    jinv: Vec<se3::Jinv>,
     /// Each node's frame increment at constant velocities: the centre of [`TRUST`].
     predicted: Vec<[f64; 6]>,
     /// Whether the step's last Newton iteration headed for another root ([`TRUST`]).
@@ -276,6 +279,7 @@ impl<'s> Integrator<'s> {
             step_q: vec![0.0; n],
             step_frames: vec![[0.0; 6]; nodes],
             rate_maps: vec![([0.0; 36], [0.0; 36]); nodes],
+            jinv: vec![se3::Jinv::new(&[f64::NAN; 6]); nodes],
             predicted: vec![[0.0; 6]; nodes],
             far: false,
             predictor: Predictor::Acceleration,

@@ -358,11 +358,12 @@ impl Integrator<'_> {
             let all = self.exact_rates;
             for k in 0..self.sys.rotations.len() {
                 if all || self.sys.is_frame(k) {
+                    self.jinv[k] = se3::Jinv::new(&self.step_frames[k]);
                     self.rate_maps[k] = se3::rate_maps(
                         self.sys,
                         &self.trial,
                         k,
-                        &self.step_frames[k],
+                        &self.jinv[k],
                         coeffs.velocity,
                         coeffs.mass,
                     );
@@ -442,7 +443,8 @@ impl Integrator<'_> {
                     rhs[r + 1],
                     rhs[r + 2],
                 ];
-                let dd = se3::increment(self.sys, k, &self.step_frames[k], &d);
+                let d0 = &self.step_frames[k];
+                let dd = se3::increment(self.sys, k, d0, &d, self.jinv[k].at(d0));
                 let (step, alg) = (&mut self.step_frames[k], &mut tr.frames[k].alg);
                 for j in 0..6 {
                     step[j] += dd[j];

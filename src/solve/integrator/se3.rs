@@ -131,18 +131,49 @@ const EXACT: f64 = 1e-3;
 /// unchanged. A correction that turns a node by more than [`EXACT`] (Newton far from the
 /// step's solution, where the retraction steers its path) composes exactly, as before: with
 /// the first-order update alone the stiff-beam two-bar at the paper's step failed at 12.15 s.
-pub fn increment(sys: &System, k: usize, d0: &[f64; 6], d: &[f64; 6]) -> [f64; 6] {
+/// `jinv`: `right_jacobian_inverse(d0)` when the caller has it (the matrix just made at
+/// this `d0`, [`Jinv`]).
+pub fn increment(
+    sys: &System,
+    k: usize,
+    d0: &[f64; 6],
+    d: &[f64; 6],
+    jinv: Option<&(M3, M3)>,
+) -> [f64; 6] {
     let (du, dth) = split(d);
     if dth.norm() > EXACT {
         let exact = compose(sys, k, d0, d);
         return std::array::from_fn(|j| exact[j] - d0[j]);
     }
     if !sys.is_frame(k) {
-        let th = left_jacobian_inverse(&-split(d0).1) * dth;
-        return join(&V3::zeros(), &th);
+        let a = jinv.map_or_else(|| left_jacobian_inverse(&-split(d0).1), |j| j.0);
+        return join(&V3::zeros(), &(a * dth));
     }
-    let (a, b) = right_jacobian_inverse(d0);
+    let (a, b) = jinv.copied().unwrap_or_else(|| right_jacobian_inverse(d0));
     join(&(a * du + b * dth), &(a * dth))
+}
+
+/// `right_jacobian_inverse(d0)` kept with its `d0`: the matrix's rate columns
+/// ([`rate_maps`]) and the correction that follows ([`increment`]) take it at the same
+/// increment, so it is made once an iteration, not twice.
+#[derive(Clone, Copy)]
+pub struct Jinv {
+    d0: [f64; 6],
+    j: (M3, M3),
+}
+
+impl Jinv {
+    pub fn new(d0: &[f64; 6]) -> Jinv {
+        Jinv {
+            d0: *d0,
+            j: right_jacobian_inverse(d0),
+        }
+    }
+
+    /// The kept maps if they were made at `d0` (bit for bit).
+    pub fn at(&self, d0: &[f64; 6]) -> Option<&(M3, M3)> {
+        (self.d0.map(f64::to_bits) == d0.map(f64::to_bits)).then_some(&self.j)
+    }
 }
 
 /// `log(exp(d0) exp(d))` in SE(3), twists as `(u, theta)`.
@@ -189,7 +220,7 @@ pub fn rate_maps(
     sys: &System,
     st: &State,
     k: usize,
-    d0: &[f64; 6],
+    jinv: &Jinv,
     cv: f64,
     ca: f64,
 ) -> ([f64; 36], [f64; 36]) {
@@ -197,7 +228,7 @@ pub fn rate_maps(
     let g = |x: &[f64], i: usize| V3::new(x[i], x[i + 1], x[i + 2]);
     let rm = st.rot[k].matrix();
     let (w, dw) = (g(&st.v, r), g(&st.a, r));
-    let (ja, jb) = right_jacobian_inverse(d0);
+    let (ja, jb) = jinv.j;
     let a = rm * ja * rm.transpose() - M3::identity();
     let mut ev = [0.0; 36];
     let mut ea = [0.0; 36];
