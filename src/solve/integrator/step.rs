@@ -130,6 +130,7 @@ impl Integrator<'_> {
         }
         let mut newton = Newton::new(&self.set, self.sys, self.means.0);
         newton.as_new = self.reuse.mode() == NewtonMode::Full;
+        newton.rigid = self.rigid;
         let max = self.set.max_iterations;
         // Whether the last correction came from a kept matrix, and the residual's total
         // before it.
