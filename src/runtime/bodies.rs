@@ -6,7 +6,7 @@
 //! t = 0. Inertial forces (inertial components):
 //! `F_u = m a + (dw~ + w~ w~) m eta`, `F_theta = m eta~ a + J dw + w~ J w`.
 
-use super::rotation::{tilde, M3, V3};
+use super::rotation::{tilde, tilde_tilde, M3, V3};
 use super::{m3, Energy, MassMoments, Residual, State, TangentCoeffs};
 use serde::{Deserialize, Serialize};
 
@@ -117,7 +117,7 @@ impl RigidBody {
     fn residual_at(&self, k: &Kin, r: &mut Residual) {
         let (wt, dwt) = (tilde(&k.w), tilde(&k.dw));
         let g = V3::from(self.gravity);
-        let fu = self.mass * k.a + (dwt + wt * wt) * k.meta;
+        let fu = self.mass * k.a + dwt * k.meta + wt * (wt * k.meta);
         let ft = k.meta.cross(&k.a) + k.j * k.dw + k.w.cross(&(k.j * k.w));
         let gt = k.meta.cross(&g);
         for i in 0..3 {
@@ -134,23 +134,32 @@ impl RigidBody {
     }
 
     fn tangent_at(&self, kin: &Kin, c: TangentCoeffs, k: &mut [f64]) {
-        let (wt, dwt, at) = (tilde(&kin.w), tilde(&kin.dw), tilde(&kin.a));
-        let et = tilde(&kin.meta);
+        let (wt, dwt) = (tilde(&kin.w), tilde(&kin.dw));
         let jw = kin.j * kin.w;
         let jdw = kin.j * kin.dw;
         let g = V3::from(self.gravity);
+        let wj = wt * kin.j;
         // Mass.
         let m_uu = M3::identity() * self.mass;
-        let m_ut = et.transpose();
-        let m_tu = et;
         let m_tt = kin.j;
         // Gyroscopic: d F^I / d(v, w).
-        let g_ut = tilde(&(wt * kin.meta)).transpose() + wt * et.transpose();
-        let g_tt = wt * kin.j - tilde(&jw);
-        // Configuration: d F^I / d theta at fixed (a, dw) and (v, w); gravity moment.
-        let k_ut = (dwt + wt * wt) * et.transpose();
-        let k_tt = at * et + kin.j * dwt - tilde(&jdw) + wt * kin.j * wt - wt * tilde(&jw);
-        let k_grav = -tilde(&g) * et;
+        let g_tt = wj - tilde(&jw);
+        // Configuration: d F^I / d theta at fixed (a, dw) and (v, w).
+        let mut k_tt = kin.j * dwt - tilde(&jdw) + wj * wt - tilde_tilde(&kin.w, &jw);
+        // The terms of the first moment of mass about the node, none for a node at the
+        // centre of mass (the two-bar's bars): the coupling of translation and rotation and
+        // the gravity moment. `e~ = tilde(meta)`; `tilde(a) tilde(b)` as `tilde_tilde`.
+        let (mut m_ut, mut g_ut, mut k_ut, mut k_grav) =
+            (M3::zeros(), M3::zeros(), M3::zeros(), M3::zeros());
+        if kin.meta != V3::zeros() {
+            let et = tilde(&kin.meta);
+            m_ut = -et;
+            g_ut = tilde(&(wt * kin.meta)).transpose() - wt * et;
+            k_ut = -(dwt * et + tilde_tilde(&kin.w, &kin.w) * et);
+            k_tt += tilde_tilde(&kin.a, &kin.meta);
+            k_grav = -tilde_tilde(&g, &kin.meta);
+        }
+        let m_tu = -m_ut;
         let blocks = [
             (0, 0, m_uu * c.mass),
             (0, 3, m_ut * c.mass + g_ut * c.velocity + k_ut * c.position),

@@ -39,6 +39,18 @@ pub fn tilde(a: &V3) -> M3 {
     M3::new(0.0, -a.z, a.y, a.z, 0.0, -a.x, -a.y, a.x, 0.0)
 }
 
+/// `tilde(a) tilde(b)`, formed as `b a^T - (a . b) I` (`a x (b x v) = b (a . v) - v (a . b)`)
+/// without the product of the two matrices.
+#[inline]
+pub fn tilde_tilde(a: &V3, b: &V3) -> M3 {
+    let mut m = b * a.transpose();
+    let d = a.dot(b);
+    m.m11 -= d;
+    m.m22 -= d;
+    m.m33 -= d;
+    m
+}
+
 /// Axial vector of the skew-symmetric part of `m`, the inverse of `tilde`.
 #[inline]
 pub fn axial(m: &M3) -> V3 {

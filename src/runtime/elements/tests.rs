@@ -154,7 +154,16 @@ fn elements(rng: &mut Lcg, case: usize) -> Vec<Element> {
             dofs: [6, 7, 8, 9, 10, 11],
             node: 1,
             mass: 1.0 + rng.next().abs(),
-            eta0: rng.v3(),
+            // Every fifth case: the node at the centre of mass (the tangent's terms of the
+            // first moment of mass are then not formed).
+            eta0: {
+                let eta = rng.v3();
+                if case % 5 == 4 {
+                    [0.0; 3]
+                } else {
+                    eta
+                }
+            },
             inertia0: {
                 let r = crate::runtime::m3(&rng.rotation(3.0));
                 let d = crate::runtime::rotation::M3::from_diagonal(&V3::new(

@@ -8,7 +8,7 @@
 //! mass's rotation) are computed but not assembled. Rows with a prescribed motion subtract a
 //! time function; rate rows are velocity-level constraints `grad G . V - f(t)`.
 
-use super::rotation::{tilde, M3, V3};
+use super::rotation::{tilde, tilde_tilde, M3, V3};
 use super::timefn::TimeFn;
 use super::{Augment, Rate, Residual, State};
 use serde::{Deserialize, Serialize};
@@ -134,28 +134,24 @@ impl Row {
             Row::Point { k } => {
                 let mut m = V3::zeros();
                 m[*k] = mu;
-                let mt = tilde(&m);
                 if ra {
-                    block(h, TA, TA, &(-mt * tilde(&g.a.p)));
+                    block(h, TA, TA, &-tilde_tilde(&m, &g.a.p));
                 }
                 if rb {
-                    block(h, TB, TB, &(mt * tilde(&g.b.p)));
+                    block(h, TB, TB, &tilde_tilde(&m, &g.b.p));
                 }
             }
             Row::Dot { i, j } => {
-                let (at, bt) = (
-                    tilde(&g.a.e.column(*i).into_owned()),
-                    tilde(&g.b.e.column(*j).into_owned()),
-                );
+                let (a, b) = (g.a.e.column(*i).into_owned(), g.b.e.column(*j).into_owned());
                 if ra {
-                    let ba = bt * at * mu;
+                    let ba = tilde_tilde(&b, &a) * mu;
                     block(h, TA, TA, &ba);
                     if rb {
                         block(h, TB, TA, &-ba);
                     }
                 }
                 if rb {
-                    let ab = at * bt * mu;
+                    let ab = tilde_tilde(&a, &b) * mu;
                     block(h, TB, TB, &ab);
                     if ra {
                         block(h, TA, TB, &-ab);
@@ -240,7 +236,7 @@ fn along_hess(g: &Geo, i: usize, mu: f64, h: &mut Hess) {
     let a = g.a.e.column(i).into_owned();
     let at = tilde(&a) * mu;
     let w = g.d() + g.a.p;
-    let pbt = tilde(&g.b.p);
+    let pb = &g.b.p;
     // As in `Row::hess`: no blocks on an end's missing rotation slots.
     let (ra, rb) = (g.a.turns, g.b.turns);
     if ra {
@@ -248,14 +244,14 @@ fn along_hess(g: &Geo, i: usize, mu: f64, h: &mut Hess) {
         block(h, UB, TA, &-at);
         block(h, TA, UA, &-at);
         block(h, TA, UB, &at);
-        block(h, TA, TA, &(tilde(&w) * at));
+        block(h, TA, TA, &(tilde_tilde(&w, &a) * mu));
         if rb {
-            block(h, TA, TB, &(-at * pbt));
-            block(h, TB, TA, &(-pbt * at));
+            block(h, TA, TB, &(tilde_tilde(&a, pb) * -mu));
+            block(h, TB, TA, &(tilde_tilde(pb, &a) * -mu));
         }
     }
     if rb {
-        block(h, TB, TB, &(at * pbt));
+        block(h, TB, TB, &(tilde_tilde(&a, pb) * mu));
     }
 }
 
