@@ -329,9 +329,10 @@ fn refines_where_the_factors_grow_and_only_there() -> Result<(), LinearError> {
 /// their substitutions agree with the supernodal factors' to round-off (17, 44, 51 and 72
 /// unknowns: measured 2.8e-16, 4.0e-15, 3.7e-15 and 4.0e-16 of the largest entry apart;
 /// unrefined). Their sparse patterns leave most of each dense column outside the factors'
-/// reach, which the elimination skips.
+/// reach, which the elimination skips: its rows and columns fall in up to 2 runs each.
 #[test]
 fn the_dense_path_solves_as_the_supernodal_one() {
+    let mut most = (0, 0);
     for (nodes, w, k) in [(2, 6, 5), (4, 6, 5), (12, 3, 1), (10, 6, 1)] {
         let (pattern, late, values) = augmented(nodes, w, k, 3);
         assert!(pattern.n <= dense::DENSE_MAX, "{} unknowns", pattern.n);
@@ -342,6 +343,10 @@ fn the_dense_path_solves_as_the_supernodal_one() {
             .zip(&mut x)
         {
             let mut lu = make(&pattern, &late, Rule::OneSide);
+            if let Some(dense) = &lu.dense {
+                let (rows, cols) = dense.most_runs();
+                most = (most.0.max(rows), most.1.max(cols));
+            }
             assert!(lu.factor(&values).is_ok(), "{nodes} nodes of {w}");
             lu.substitute(x);
         }
@@ -353,4 +358,6 @@ fn the_dense_path_solves_as_the_supernodal_one() {
             gap / size
         );
     }
+    eprintln!("most runs of rows and of columns: {most:?}");
+    assert!(most.0 > 1 && most.1 > 1, "{most:?}");
 }
