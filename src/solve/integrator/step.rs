@@ -119,7 +119,12 @@ impl Integrator<'_> {
     /// [`Integrator::newton`]'s iteration.
     fn iterate(&mut self, h: f64, predictor: Predictor) -> Result<(), StepFailure> {
         let aug = self.scaling(h);
-        let rescale = self.aug.s / aug.s;
+        // (A step of the last one's size, the usual one, is not rescaled: no division.)
+        let rescale = if aug.s == self.aug.s {
+            1.0
+        } else {
+            self.aug.s / aug.s
+        };
         let fet = self.method == Method::Fet;
         let keep_rate = self.reuse.begin();
         let factorizations = self.stats.factorizations;
@@ -142,7 +147,7 @@ impl Integrator<'_> {
         for it in 0..=max {
             let mut r = self.residual(fet, h, aug, newton.floor)?;
             let mut total = r.force + aug.s * r.constraint;
-            newton.residual_rate = total / last_total;
+            newton.residual_totals = (total, last_total);
             if newton.converged(r.force, r.scale, r.constraint) {
                 self.reuse
                     .end(it, self.stats.factorizations - factorizations);
