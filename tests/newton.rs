@@ -197,8 +197,9 @@ fn exact_frame_columns_take_two_iterations_a_step_in_smooth_motion() {
         factored,
         1.02,
     );
-    // P3 at its step, 0.05 s, 50 s: measured 3.399 iterations a step (those of the attempts
-    // that converged), 3.045 factorizations a step, no halving (3.432 and 3.078 before a kept
+    // P3 at its step, 0.05 s, 50 s: measured 3.231 iterations a step (those of the attempts
+    // that converged), 2.798 factorizations a step, no halving (3.399 and 3.045 before the
+    // predictors that continue the scheme's ringing; 3.432 and 3.078 before a kept
     // matrix's contraction could end a step above the increment tolerance; 3.457 and 3.194
     // before the extrapolating predictors), with the predictor chosen by the
     // last step (`Predictor`) and a new matrix's correction ending the step when the
@@ -213,8 +214,9 @@ fn exact_frame_columns_take_two_iterations_a_step_in_smooth_motion() {
     within("factorizations a step, P3 at 0.05 s", factored, 3.5);
     assert_eq!(p3.halvings, 0, "halvings, P3 at 0.05 s");
     // The motion after the load reversal is chaotic at this step: the steps next to it take
-    // other paths. Measured 3.383, 3.415 and 3.348 iterations a step at 0.0498, 0.0499 and
-    // 0.0501 s (3.412, 3.446 and 3.374 before a kept matrix's contraction could end a step;
+    // other paths. Measured 3.210, 3.225 and 3.187 iterations a step at 0.0498, 0.0499 and
+    // 0.0501 s (3.383, 3.415 and 3.348 before the ringing predictors; 3.412, 3.446 and 3.374
+    // before a kept matrix's contraction could end a step;
     // 3.452, 3.465 and 3.413 before the extrapolating predictors; 3.79, 3.77 and
     // 3.70 without the order's test), none halved (4.17 to 3.91 with 2, 11 and 1 halvings before); 0.0497 and
     // 0.0502 s halve 5 and 7 times (3 and 5 before).

@@ -266,7 +266,7 @@ impl<'s> Integrator<'s> {
             lambda_prev: (vec![0.0; n], None),
             lambda_prev2: (vec![0.0; n], false),
             last_h: None,
-            history: history::History::new(n, nodes),
+            history: history::History::new(n, nodes, Scheme::of(set).ringing()),
             mass_lu: None,
             transform,
             mats: vec![M3::identity(); blocks.len()],

