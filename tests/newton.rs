@@ -71,12 +71,12 @@ fn kept_matrices_solve_the_same_steps_with_fewer_factorizations() {
         full_stats.newton_iterations, full_stats.factorizations
     );
     for (mode, gap_bound, share_bound) in [
-        // Measured: full 5.7e-7 rad off with 25,862 factorizations for as many iterations;
-        // modified 5.4e-7 rad and 0.023 (52,215 iterations), auto 1.8e-7 rad and 0.075
-        // (38,409 iterations). Against the reduced equations all three are 1.89e-2 rad off
-        // (the truncation error), auto's 0.9995 of full's.
-        (NewtonMode::Modified, 1.6e-6, 0.07),
-        (NewtonMode::Auto, 5e-7, 0.22),
+        // Measured: full 2.7e-11 rad off with 8,000 factorizations for 10,029 iterations;
+        // modified 4.3e-7 rad and 0.022 (52,278 iterations), auto 1.5e-7 rad and 0.076
+        // (37,104 iterations). Against the reduced equations all three are 1.89e-2 rad off
+        // (the truncation error).
+        (NewtonMode::Modified, 1.3e-6, 0.066),
+        (NewtonMode::Auto, 4.5e-7, 0.22),
     ] {
         let (run, stats) = two_bar(dt, until, mode, 1e-10);
         let gap = largest_difference(&run, &exact);
@@ -157,8 +157,8 @@ fn on_the_windmill_full_newton_lands_on_the_discrete_solution() {
         gap(&hub(NewtonMode::Auto, 1e-10)),
     );
     eprintln!("windmill hub off the discrete solution: full {full:.3e}, auto {auto:.3e} of its largest motion");
-    // Measured: full 9.5e-9 (6.8e-5 with the columns before), auto 1.5e-6.
-    within("full's hub motion off the discrete solution", full, 3e-8);
+    // Measured: full 6.0e-11 (6.8e-5 with the columns before), auto 1.46e-6.
+    within("full's hub motion off the discrete solution", full, 1.8e-10);
     within("auto's hub motion off the discrete solution", auto, 4.5e-6);
 }
 
