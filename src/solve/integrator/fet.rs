@@ -127,6 +127,7 @@ impl Integrator<'_> {
             scale,
             constraint: cnorm,
             worst: worst.1,
+            own: None,
         })
     }
 

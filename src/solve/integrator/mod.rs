@@ -63,13 +63,15 @@ enum Layout {
 }
 
 /// The norms of a residual: forces, their scale, the constraint violation, and the unknown
-/// with the largest scaled entry.
+/// with the largest scaled entry; under kept matrices also the largest force over its own
+/// entity's scale ([`Newton::own`]).
 #[derive(Clone, Copy, Debug)]
 struct Norms {
     force: f64,
     scale: f64,
     constraint: f64,
     worst: usize,
+    own: Option<f64>,
 }
 
 /// What stopped [`Integrator::run`]: a failed step, or the caller.
@@ -110,6 +112,8 @@ pub struct Integrator<'s> {
     last_h: Option<f64>,
     /// The algorithmic accelerations of the last steps, for the extrapolating predictors.
     history: history::History,
+    /// Each entity's force scale in the last residual, under kept matrices ([`Norms::own`]).
+    own_scale: Vec<f64>,
     /// Whether each step may keep the matrix (`newton = auto` decides step by step).
     reuse: Reuse,
     /// The constrained mass matrix's (the start), with pivoting, made on first use.
@@ -268,6 +272,7 @@ impl<'s> Integrator<'s> {
             last_h: None,
             history: history::History::new(n, nodes, Scheme::of(set).ringing()),
             mass_lu: None,
+            own_scale: vec![0.0; sys.owners.iter().max().map_or(0, |&o| o + 1)],
             transform,
             mats: vec![M3::identity(); blocks.len()],
             blocks,

@@ -155,8 +155,11 @@ impl Integrator<'_> {
         self.fused = (first.then(|| self.newmark_coefficients(h)), false);
         for it in 0..=max {
             let mut r = self.residual(fet, h, aug, newton.floor)?;
-            let mut total = r.force + aug.s * r.constraint;
+            // Under kept matrices the forces count against their own entity's scale, as the
+            // residual test takes them (`Newton::own`), in the contraction the matrix is kept by.
+            let mut total = r.own.map_or(r.force, |x| x * r.scale) + aug.s * r.constraint;
             newton.residual_totals = (total, last_total);
+            newton.own = r.own;
             if newton.converged(r.force, r.scale, r.constraint) {
                 self.reuse
                     .end(it, self.stats.factorizations - factorizations);
@@ -168,7 +171,7 @@ impl Integrator<'_> {
             if rejected {
                 self.restore();
                 r = self.residual(fet, h, aug, newton.floor)?;
-                total = r.force + aug.s * r.constraint;
+                total = r.own.map_or(r.force, |x| x * r.scale) + aug.s * r.constraint;
             }
             let what = if fet { " of the time element" } else { "" };
             let norms = (r.force, r.scale, r.constraint);
