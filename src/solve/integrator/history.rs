@@ -105,10 +105,22 @@ impl History {
     /// or `n + 6 k + j` for component `j` of node `k`'s frame), whose value now is `now`.
     #[inline]
     pub(super) fn extrapolate(&self, p: usize, i: usize, now: f64) -> f64 {
+        Self::extrapolate_from(p, now, &self.slot(i))
+    }
+
+    /// Slot `i`'s past values, newest first (those beyond [`History::orders`] stale).
+    #[inline]
+    pub(super) fn slot(&self, i: usize) -> [f64; ORDERS] {
+        std::array::from_fn(|j| self.past[j][i])
+    }
+
+    /// [`History::extrapolate`] from a slot's past values.
+    #[inline]
+    pub(super) fn extrapolate_from(p: usize, now: f64, past: &[f64; ORDERS]) -> f64 {
         let c = &COEF[p - 1];
         let mut x = c[0] * now;
         for j in 0..p {
-            x += c[j + 1] * self.past[j][i];
+            x += c[j + 1] * past[j];
         }
         x
     }
@@ -117,10 +129,16 @@ impl History {
     /// that continues the scheme's ringing as well as a polynomial of degree `d - 1`.
     #[inline]
     pub(super) fn ringing(&self, d: usize, i: usize, now: f64) -> f64 {
+        self.ringing_from(d, now, &self.slot(i))
+    }
+
+    /// [`History::ringing`] from a slot's past values.
+    #[inline]
+    pub(super) fn ringing_from(&self, d: usize, now: f64, past: &[f64; ORDERS]) -> f64 {
         let c = &self.ring[d - 1];
         let mut x = c[0] * now;
         for j in 0..=d {
-            x += c[j + 1] * self.past[j][i];
+            x += c[j + 1] * past[j];
         }
         x
     }
