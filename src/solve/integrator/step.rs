@@ -53,10 +53,13 @@ impl Predictor {
 const TRUST: f64 = 1.0;
 
 impl Integrator<'_> {
-    /// Keeps the iterate before a correction.
+    /// Keeps the iterate before a correction (the mid-configuration only for time finite
+    /// elements, the only method that reads it).
     fn save(&mut self) {
         self.saved.0.assign(&self.trial);
-        self.saved.1.assign(&self.mid);
+        if self.method == Method::Fet {
+            self.saved.1.assign(&self.mid);
+        }
         self.saved_steps.0.copy_from_slice(&self.step_q);
         self.saved_steps.1.copy_from_slice(&self.step_frames);
     }
@@ -91,7 +94,9 @@ impl Integrator<'_> {
     /// Returns to the iterate before the last correction.
     fn restore(&mut self) {
         self.trial.assign(&self.saved.0);
-        self.mid.assign(&self.saved.1);
+        if self.method == Method::Fet {
+            self.mid.assign(&self.saved.1);
+        }
         self.step_q.copy_from_slice(&self.saved_steps.0);
         self.step_frames.copy_from_slice(&self.saved_steps.1);
     }
