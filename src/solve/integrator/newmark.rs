@@ -17,6 +17,7 @@
 //! unknowns hold `c`, `c-dot`, `c-ddot` like any coordinate ([`super::rotations`]).
 
 use super::history::{History, ORDERS, RINGS};
+use super::newton::larger;
 use super::{rotations, se3};
 use super::{Integrator, Layout, Norms, Predictor, StepFailure};
 use crate::runtime::precise;
@@ -254,7 +255,6 @@ impl Integrator<'_> {
         // Each slot's past values read once for all the predictors (they were 4 % of a
         // windmill run under `auto`, read predictor by predictor); the same arithmetic as
         // `Scheme::predicted_pair`.
-        let larger = |m: f64, a: f64| if a > m { a } else { m };
         let mut count = |taken: f64, (v, a, alg0): (f64, f64, f64), slot: usize, scale: f64| {
             let x = past.slot(slot);
             for (m, &p) in miss.iter_mut().zip(all) {
@@ -326,9 +326,7 @@ impl Integrator<'_> {
         };
         self.block_matrices();
         let r = &self.asm.residual;
-        // `larger`, not `f64::max`: a NaN shows in `rhs` (checked below), and this compiles to
-        // one `maxsd` (`f64::max`'s NaN handling was a quarter of this function's time).
-        let larger = |m: f64, a: f64| if a > m { a } else { m };
+        // `larger`, not `f64::max`: a NaN shows in `rhs` (checked below).
         let (mut scale, mut cnorm) = (floor, 0.0f64);
         for i in 0..n {
             if self.sys.unknowns[i].is_multiplier() {

@@ -310,6 +310,17 @@ impl Reuse {
     }
 }
 
+/// The larger of `m` and `a`, ignoring a NaN `a` as `f64::max` does, in one `maxsd` (the NaN
+/// handling of `f64::max` was a quarter of the residual's norms).
+#[inline(always)]
+pub(super) fn larger(m: f64, a: f64) -> f64 {
+    if a > m {
+        a
+    } else {
+        m
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::Newton;
