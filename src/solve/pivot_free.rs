@@ -231,14 +231,7 @@ impl PivotFree {
             self.a.copy_from_slice(values);
         }
         if let Some(dense) = &mut self.dense {
-            for (j, &c) in self.new_of.iter().enumerate() {
-                let column = &values[self.col_ptr[j]..self.col_ptr[j + 1]];
-                // As below: a NaN shows as a NaN pivot.
-                self.scale[c] = column
-                    .iter()
-                    .fold(0.0, |m, v| if v.abs() > m { v.abs() } else { m });
-            }
-            return dense.factor(values, &self.scale, &self.perm);
+            return dense.factor(values, &mut self.scale, &self.perm);
         }
         for &d in &self.fill {
             self.x[d] = 0.0;

@@ -336,7 +336,7 @@ fn put(gr: &mut Grad, at: usize, v: &V3) {
     gr[at..at + 3].copy_from_slice(v.as_slice());
 }
 
-#[inline]
+#[inline(always)]
 fn block(h: &mut Hess, r0: usize, c0: usize, m: &M3) {
     for i in 0..3 {
         for j in 0..3 {
