@@ -190,7 +190,7 @@ impl Integrator<'_> {
             let keep = if self.reuse.mode() == NewtonMode::Full {
                 (self.rigid || self.smooth) && newton.quadratic()
             } else {
-                self.kept == Some(h) && newton.rate() <= keep_rate
+                self.kept == Some(h) && newton.rate() <= keep_rate && !newton.stuck()
             };
             let fresh = rejected || !keep;
             if fresh {
