@@ -109,7 +109,7 @@ impl Newton {
     /// matrix's does.
     pub(super) fn converged(&self, rnorm: f64, scale: f64, cnorm: f64) -> bool {
         let small = self.increment_ok && cnorm <= self.ltol;
-        let noise = self.last_increment <= 1e-3 * self.atol;
+        let noise = self.at_noise();
         if !self.fresh {
             let rate = if self.previous_increment.is_nan() {
                 self.residual_totals.0 / self.residual_totals.1
@@ -181,13 +181,18 @@ impl Newton {
     /// the second correction of a step, and at round-off level, 1e-3 of the tolerance, where
     /// it is not measurable; infinite after a zero increment).
     pub(super) fn rate(&self) -> f64 {
-        if self.previous_increment.is_nan() || self.last_increment <= 1e-3 * self.atol {
+        if self.previous_increment.is_nan() || self.at_noise() {
             0.0
         } else if self.previous_increment > 0.0 {
             self.last_increment / self.previous_increment
         } else {
             f64::INFINITY
         }
+    }
+
+    /// Whether the last correction is at round-off: 1e-3 of the increment tolerance.
+    fn at_noise(&self) -> bool {
+        self.last_increment <= 1e-3 * self.atol
     }
 
     /// Whether kept matrices' last [`STALLS`] corrections were at round-off and each left the
@@ -200,7 +205,7 @@ impl Newton {
     /// tolerance, and a further kept correction usually ends the step.)
     pub(super) fn stuck(&mut self) -> bool {
         let stalled = !self.fresh
-            && self.last_increment <= 1e-3 * self.atol
+            && self.at_noise()
             && self.residual_totals.0 >= 0.5 * self.residual_totals.1;
         self.stalls = if stalled { self.stalls + 1 } else { 0 };
         self.stalls >= STALLS
