@@ -233,6 +233,46 @@ def test_ctrl_c_stops_a_run_cleanly_and_the_next_run_goes_on():
     assert "again True 3" in out, out + err
 
 
+def test_runs_from_several_threads_at_once_and_one_after_another_agree():
+    m = mbd.compile(MODELS / "two_bar.mbd")
+    want = m.run(until=0.5)
+    results = [None] * 4
+
+    def work(k):
+        results[k] = m.run(until=0.5)
+
+    threads = [threading.Thread(target=work, args=(k,)) for k in range(4)]
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    for r in results + [m.run(until=0.5)]:
+        assert r.ok and r.rows == want.rows
+        assert same_bits(r["xc2"], want["xc2"])
+
+
+def test_a_child_forked_after_a_run_runs_too():
+    # The parent's worker threads are not in the child: a child that sent its run to one
+    # of them would wait for ever.
+    script = (
+        "import mbd, os, sys\n"
+        "m = mbd.compile(sys.argv[1])\n"
+        "print('parent', m.run(until=0.1).rows, flush=True)\n"
+        "pid = os.fork()\n"
+        "if pid == 0:\n"
+        "    print('child', m.run(until=0.1).rows, flush=True)\n"
+        "    os._exit(0)\n"
+        "os.waitpid(pid, 0)\n"
+        "print('parent again', m.run(until=0.1).rows, flush=True)\n"
+    )
+    p = subprocess.run([sys.executable, "-c", script, str(MODELS / "pendulum.mbd")],
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0, p.stderr
+    lines = [line.rsplit(" ", 1) for line in p.stdout.splitlines()]
+    assert [who for who, _ in lines] == ["parent", "child", "parent again"], p.stdout
+    assert len({rows for _, rows in lines}) == 1 and int(lines[0][1]) > 1, p.stdout
+
+
 # -- modes ---------------------------------------------------------------------------------
 
 def test_modes_equal_the_cli_tables(tmp_path):
