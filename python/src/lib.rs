@@ -13,6 +13,7 @@ use mbd::{CompileFailure, Compiled};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::sync::{mpsc, Mutex};
 use std::time::Duration;
 
@@ -29,54 +30,82 @@ const WATCH: Duration = Duration::from_millis(50);
 /// the worker calls once it is idle again.
 type Job = Box<dyn FnOnce() -> Box<dyn FnOnce() + Send> + Send>;
 
-/// The idle workers, each by the sender of its jobs, and the process they belong to. A worker
-/// outlives its call and is reused: a fresh thread's run pays for its stack's and heap's first
-/// pages, and the thread's start and end. The pendulum's 50 steps at 0.02 s, `compile` then
-/// `run` (medians of 41 pairs, two series each): 80-85 us of the run's thread CPU and
-/// 628-659 us of wall clock on fresh threads, 69-72 and 335-363 us on a reused one.
-static IDLE: Mutex<(u32, Vec<mpsc::Sender<Job>>)> = Mutex::new((0, Vec::new()));
+/// The idle workers, each by its number and the sender of its jobs, and the process they
+/// belong to. A worker outlives its call and is reused: a fresh thread's run pays for its
+/// stack's and heap's first pages, and the thread's start and end. The pendulum's 50 steps at
+/// 0.02 s, `compile` then `run` (medians of 41 pairs, two series each): 80-85 us of the run's
+/// thread CPU and 628-659 us of wall clock on fresh threads, 69-72 and 335-363 us on a reused
+/// one. A worker idle for [`LINGER`] ends.
+static IDLE: Mutex<(u32, Vec<Idle>)> = Mutex::new((0, Vec::new()));
 
-/// An idle worker of this process, or a new one (64 MiB of stack, as the compiler's recursion
-/// may need). A child forked from a process with idle workers has none of their threads: the
-/// process id tells, and the child starts its own. The lock is only tried: a lock that a fork
-/// left held, or another call holding it, costs a new thread, never a wait.
+/// An idle worker: its number and the sender of its jobs.
+type Idle = (u64, mpsc::Sender<Job>);
+
+/// The workers' numbers.
+static WORKERS: AtomicU64 = AtomicU64::new(0);
+
+/// How long a worker waits idle for its next call before it ends (so that a process that ran
+/// mbd a while ago, and forks now, has no thread of mbd's).
+const LINGER: Duration = Duration::from_secs(1);
+
+/// An idle worker of this process, or a new one. A child forked from a process with idle
+/// workers has none of their threads: the process id tells, and the child starts its own. The
+/// lock is only tried: a lock that a fork left held, or another call holding it, costs a new
+/// thread, never a wait.
 fn worker() -> PyResult<mpsc::Sender<Job>> {
     let pid = std::process::id();
     if let Ok(mut idle) = IDLE.try_lock() {
         if idle.0 != pid {
             *idle = (pid, Vec::new());
         }
-        if let Some(tx) = idle.1.pop() {
+        if let Some((_, tx)) = idle.1.pop() {
             return Ok(tx);
         }
     }
+    spawn(pid)
+}
+
+/// A new worker (64 MiB of stack, as the compiler's recursion may need).
+fn spawn(pid: u32) -> PyResult<mpsc::Sender<Job>> {
     let (tx, rx) = mpsc::channel::<Job>();
     let me = tx.clone();
+    let number = WORKERS.fetch_add(1, Ordering::Relaxed);
     std::thread::Builder::new()
         .name("mbd".to_string())
         .stack_size(64 << 20)
-        .spawn(move || {
-            for job in rx {
-                // A job that panicked leaves this worker (its result's sender dropped, its
-                // caller told of an internal error); the next call starts another.
-                let Ok(deliver) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job))
-                else {
-                    return;
-                };
-                // Idle again before the result is handed over, so that the caller's next
-                // call finds this worker. Where the lock is busy, the worker ends after this
-                // job.
-                let back = match IDLE.try_lock() {
-                    Ok(mut idle) if idle.0 == pid => {
-                        idle.1.push(me.clone());
-                        true
-                    }
-                    _ => false,
-                };
-                deliver();
-                if !back {
-                    return;
+        .spawn(move || loop {
+            let job = match rx.recv_timeout(LINGER) {
+                Ok(job) => job,
+                // Idle too long: the worker leaves the idle list and ends, unless a call has
+                // just taken it from there (its job is on the way).
+                Err(_) => match IDLE.lock() {
+                    Ok(mut idle) => match idle.1.iter().position(|(n, _)| *n == number) {
+                        Some(at) => {
+                            idle.1.swap_remove(at);
+                            return;
+                        }
+                        None => continue,
+                    },
+                    Err(_) => return,
+                },
+            };
+            // A job that panicked ends this worker (its result's sender dropped, its caller
+            // told of an internal error); the next call starts another.
+            let Ok(deliver) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(job)) else {
+                return;
+            };
+            // Idle again before the result is handed over, so that the caller's next call
+            // finds this worker.
+            let back = match IDLE.lock() {
+                Ok(mut idle) if idle.0 == pid => {
+                    idle.1.push((number, me.clone()));
+                    true
                 }
+                _ => false,
+            };
+            deliver();
+            if !back {
+                return;
             }
         })
         .map_err(|e| PyRuntimeError::new_err(format!("cannot start a thread: {e}")))?;
@@ -97,9 +126,12 @@ pub(crate) fn interruptible<T: Send + 'static>(
                 let _ = tx.send(out);
             })
         });
-        worker()?
-            .send(job)
-            .map_err(|_| PyRuntimeError::new_err("mbd's worker thread has stopped"))?;
+        // A worker that ended as it was taken hands the job back: a new one takes it.
+        if let Err(mpsc::SendError(job)) = worker()?.send(job) {
+            spawn(std::process::id())?
+                .send(job)
+                .map_err(|_| PyRuntimeError::new_err("mbd's worker thread has stopped"))?;
+        }
         let mut signal: Option<PyErr> = None;
         let result = loop {
             match rx.recv_timeout(WATCH) {

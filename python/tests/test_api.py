@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import threading
+import time
 import warnings
 
 import numpy as np
@@ -224,7 +225,6 @@ def test_ctrl_c_stops_a_run_cleanly_and_the_next_run_goes_on():
     p = subprocess.Popen([sys.executable, "-c", script, str(MODELS / "pendulum.mbd")],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     assert p.stdout.readline().strip() == "ready"
-    import time
     time.sleep(1.0)
     p.send_signal(signal.SIGINT)
     out, err = p.communicate(timeout=60)
@@ -249,6 +249,21 @@ def test_runs_from_several_threads_at_once_and_one_after_another_agree():
     for r in results + [m.run(until=0.5)]:
         assert r.ok and r.rows == want.rows
         assert same_bits(r["xc2"], want["xc2"])
+
+
+def test_a_worker_is_reused_and_ends_when_idle():
+    def workers():
+        tasks = pathlib.Path("/proc/self/task")
+        return sum((t / "comm").read_text().strip() == "mbd" for t in tasks.iterdir())
+
+    m = mbd.compile(MODELS / "pendulum.mbd")
+    time.sleep(1.5)
+    assert workers() == 0
+    for _ in range(5):
+        m.run(until=0.1)
+        assert workers() == 1
+    time.sleep(1.5)
+    assert workers() == 0
 
 
 def test_a_child_forked_after_a_run_runs_too():
