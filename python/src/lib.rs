@@ -95,8 +95,10 @@ fn spawn(pid: u32) -> PyResult<mpsc::Sender<Job>> {
                 return;
             };
             // Idle again before the result is handed over, so that the caller's next call
-            // finds this worker.
-            let back = match IDLE.lock() {
+            // finds this worker. The lock is only tried, as by a caller: in a child forked
+            // while the lock was held it stays held, and a worker that waited for it would
+            // never hand its result over; a worker that finds it busy ends after this job.
+            let back = match IDLE.try_lock() {
                 Ok(mut idle) if idle.0 == pid => {
                     idle.1.push((number, me.clone()));
                     true
